@@ -1,0 +1,19 @@
+# Compiler settings shared by every Impetus target (and by installed plugin projects).
+include_guard(GLOBAL)
+
+add_library(impetus_compile_options INTERFACE)
+target_compile_features(impetus_compile_options INTERFACE cxx_std_20)
+if(CMAKE_CXX_COMPILER_ID MATCHES "GNU|Clang")
+  # -ffp-contract=off: no fused multiply-add contraction, so results do not depend on it (determinism).
+  target_compile_options(impetus_compile_options INTERFACE
+    $<BUILD_INTERFACE:-Wall -Wextra -Wpedantic -ffp-contract=off>)
+  if(IMPETUS_WERROR)
+    target_compile_options(impetus_compile_options INTERFACE $<BUILD_INTERFACE:-Werror>)
+  endif()
+  if(IMPETUS_SANITIZE)
+    target_compile_options(impetus_compile_options INTERFACE
+      $<BUILD_INTERFACE:-fsanitize=address,undefined -fno-omit-frame-pointer -fno-sanitize-recover=undefined>)
+    target_link_options(impetus_compile_options INTERFACE
+      $<BUILD_INTERFACE:-fsanitize=address,undefined>)
+  endif()
+endif()

@@ -1,0 +1,34 @@
+# impetus_add_plugin(<kind> <name> SOURCES <files...> [LIBRARIES <targets...>])
+#
+# Declares a module plugin in one line. <kind> is integrator, detector or resolver; <name> is the name a
+# scene uses. Builds the shared library impetus_<kind>_<name>.so (no "lib" prefix) into the plugin
+# directory the host searches, with hidden visibility (only the entry symbol is exported), and installs
+# it next to the core library. The target is named impetus_<kind>_<name>.
+include_guard(GLOBAL)
+
+function(impetus_add_plugin kind name)
+  cmake_parse_arguments(ARG "" "" "SOURCES;LIBRARIES" ${ARGN})
+  if(NOT kind MATCHES "^(integrator|detector|resolver)$")
+    message(FATAL_ERROR "impetus_add_plugin: kind must be integrator, detector or resolver, got '${kind}'")
+  endif()
+  if(NOT name MATCHES "^[a-z][a-z0-9_]*$")
+    message(FATAL_ERROR "impetus_add_plugin: name '${name}' must be lower-case letters, digits and _")
+  endif()
+  set(target impetus_${kind}_${name})
+  add_library(${target} MODULE ${ARG_SOURCES})
+  target_link_libraries(${target} PRIVATE Impetus::plugin_api ${ARG_LIBRARIES})
+  if(TARGET impetus_compile_options)
+    target_link_libraries(${target} PRIVATE impetus_compile_options)
+  endif()
+  set_target_properties(${target} PROPERTIES
+    PREFIX ""
+    OUTPUT_NAME ${target}
+    CXX_VISIBILITY_PRESET hidden
+    VISIBILITY_INLINES_HIDDEN ON)
+  if(DEFINED IMPETUS_PLUGIN_OUTPUT_DIRECTORY)
+    set_target_properties(${target} PROPERTIES LIBRARY_OUTPUT_DIRECTORY "${IMPETUS_PLUGIN_OUTPUT_DIRECTORY}")
+  endif()
+  if(DEFINED IMPETUS_PLUGIN_INSTALL_DIR)
+    install(TARGETS ${target} LIBRARY DESTINATION "${IMPETUS_PLUGIN_INSTALL_DIR}")
+  endif()
+endfunction()

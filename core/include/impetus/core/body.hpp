@@ -1,0 +1,77 @@
+#pragma once
+/// \file
+/// The rigid body: configuration (shape, mass properties, material) and state (pose, velocities).
+///
+/// Conventions (shared/DESIGN.md): `position` is the world position of the center of mass; `rotation`
+/// maps body to world coordinates (p_world = position + rotation · p_body); the body frame's origin is
+/// the center of mass. World inertia J_world = R J_body Rᵀ. Velocities are in the world frame.
+/// A fixed body has infinite mass and inertia: its inverse mass and inverse inertia are zero, so its
+/// terms vanish from every formula (paper, after eq. 8).
+
+#include "impetus/core/math.hpp"
+#include "impetus/core/shape.hpp"
+
+#include <cstdint>
+#include <limits>
+#include <string>
+
+namespace impetus {
+
+/// Index of a body in its World (stable for the World's lifetime).
+using BodyIndex = std::uint32_t;
+
+/// Surface properties of a body.
+struct Material {
+  /// Coefficient of restitution e ∈ [0, 1]; a contact uses the larger of its two bodies' values
+  /// (a rigid wall does not make a bouncing ball less elastic).
+  double restitution = 0.0;
+  /// Coefficient of Coulomb friction (stored for future resolvers; the paper's method is frictionless).
+  double friction = 0.0;
+};
+
+/// A rigid body. Plain data: modules read and write it directly.
+struct RigidBody {
+  // --- configuration ---
+  std::string name;       ///< unique within a world
+  Shape shape = Sphere{};
+  bool fixed = false;     ///< immovable: infinite mass and inertia
+  double mass = 1.0;      ///< kg (infinity for a fixed body)
+  double inv_mass = 1.0;  ///< 1/kg (0 for a fixed body)
+  Mat3 inertia_body = Mat3::Identity();      ///< kg·m² about the center of mass, body frame
+  Mat3 inv_inertia_body = Mat3::Identity();  ///< its inverse (zero for a fixed body)
+  Material material;
+  std::uint32_t collision_group = 1;  ///< bit(s) this body belongs to
+  std::uint32_t collision_mask = 0xFFFFFFFFu;  ///< groups it collides with (both ways must agree)
+
+  // --- state ---
+  Vec3 position = Vec3::Zero();          ///< center of mass, world frame (m)
+  Mat3 rotation = Mat3::Identity();      ///< body → world
+  Vec3 velocity = Vec3::Zero();          ///< of the center of mass, world frame (m/s)
+  Vec3 angular_velocity = Vec3::Zero();  ///< world frame (rad/s)
+
+  // --- applied loads (world frame, persistent until changed; gravity is added by the integrator) ---
+  Vec3 force = Vec3::Zero();   ///< N, through the center of mass
+  Vec3 torque = Vec3::Zero();  ///< N·m about the center of mass
+
+  /// J_world = R J_body Rᵀ (kg·m²).
+  Mat3 inertia_world() const { return rotation * inertia_body * rotation.transpose(); }
+  /// J_world⁻¹ = R J_body⁻¹ Rᵀ (zero for a fixed body).
+  Mat3 inv_inertia_world() const { return rotation * inv_inertia_body * rotation.transpose(); }
+  /// Velocity of the material point at world position `p`: u = v + ω × (p − x).
+  Vec3 velocity_at(const Vec3& p) const { return velocity + angular_velocity.cross(p - position); }
+  /// Orientation as a unit quaternion (w, x, y, z).
+  Quat orientation() const { return Quat(rotation).normalized(); }
+};
+
+/// Makes `body` fixed: infinite mass and inertia, zero inverses, zero velocities.
+inline void make_fixed(RigidBody& body) {
+  body.fixed = true;
+  body.mass = std::numeric_limits<double>::infinity();
+  body.inv_mass = 0.0;
+  body.inertia_body = Mat3::Identity() * std::numeric_limits<double>::infinity();
+  body.inv_inertia_body.setZero();
+  body.velocity.setZero();
+  body.angular_velocity.setZero();
+}
+
+}  // namespace impetus

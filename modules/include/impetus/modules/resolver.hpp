@@ -1,0 +1,34 @@
+#pragma once
+/// \file
+/// The collision resolver module contract.
+
+#include "impetus/core/body.hpp"
+#include "impetus/modules/constraint.hpp"
+#include "impetus/modules/contact.hpp"
+#include "impetus/modules/status.hpp"
+#include "impetus/modules/step.hpp"
+
+#include <span>
+
+namespace impetus {
+
+/// Changes body velocities by impulses so that no contact approaches (and constraints hold).
+class CollisionResolver {
+ public:
+  virtual ~CollisionResolver() = default;
+
+  /// Checked once when a world is built: fails (naming the constraint) for constraints this resolver
+  /// cannot enforce. The default accepts none.
+  virtual ModuleStatus accept_constraints(std::span<const Constraint> constraints) noexcept {
+    return constraints.empty() ? ModuleStatus::success()
+                               : ModuleStatus::failure("this resolver does not support constraints");
+  }
+
+  /// Applies impulses to `bodies` for `contacts` (writing each contact's total `impulse`) and
+  /// `constraints`, following the Contact sign convention.
+  virtual void resolve(std::span<RigidBody> bodies, std::span<Contact> contacts,
+                       std::span<const Constraint> constraints, const StepContext& ctx,
+                       ResolverCounters& counters) noexcept = 0;
+};
+
+}  // namespace impetus

@@ -1,0 +1,47 @@
+#pragma once
+/// \file
+/// What every module is told about the current step, and the counters each module reports back.
+/// Counters are reset by the world before each step; a module only adds to its own.
+
+#include "impetus/core/math.hpp"
+
+#include <cstdint>
+
+namespace impetus {
+
+/// The step being taken (read-only for modules).
+struct StepContext {
+  double dt = 1e-3;                      ///< time step (s)
+  Vec3 gravity{0.0, 0.0, -9.81};         ///< m/s²
+  std::uint64_t step = 0;                ///< index of this step (0 for the first)
+  double time = 0.0;                     ///< simulated time at the start of the step (s)
+};
+
+/// Integrator counters for one step.
+struct IntegratorCounters {
+  std::uint64_t bodies = 0;          ///< movable bodies advanced
+  std::uint64_t orthonormalized = 0; ///< rotation matrices re-orthonormalized
+};
+
+/// Detector counters for one step.
+struct DetectorCounters {
+  std::uint64_t pairs_tested = 0;      ///< candidate pairs from the broadphase
+  std::uint64_t narrowphase_calls = 0; ///< exact shape-pair tests
+  std::uint64_t contacts = 0;          ///< contacts produced
+  std::uint64_t contacts_dropped = 0;  ///< contacts rejected (NaN or zero normal, duplicates, manifold reduction)
+};
+
+/// Resolver counters for one step.
+struct ResolverCounters {
+  std::uint64_t islands = 0;           ///< independent groups solved
+  std::uint64_t contacts = 0;          ///< contacts that entered a system
+  std::uint64_t rounds = 0;            ///< solve rounds (simultaneous) or single impulses (sequential)
+  std::uint64_t pulling_impulses = 0;  ///< impulses that came out negative (would pull bodies together)
+  std::uint64_t non_converged = 0;     ///< systems that hit the iteration cap
+  std::uint64_t singular_systems = 0;  ///< systems found rank-deficient (minimum-norm solution used)
+  std::uint64_t nan_caught = 0;        ///< non-finite results rejected
+  double residual = 0.0;               ///< largest approach velocity left after resolving (m/s, ≥ 0)
+  double complementarity_error = 0.0;  ///< largest |p · v_n⁺| over the contacts (N·m/s)
+};
+
+}  // namespace impetus
