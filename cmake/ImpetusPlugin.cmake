@@ -25,6 +25,13 @@ function(impetus_add_plugin kind name)
     OUTPUT_NAME ${target}
     CXX_VISIBILITY_PRESET hidden
     VISIBILITY_INLINES_HIDDEN ON)
+  # Hidden visibility does not cover instantiations of std:: templates (libstdc++ declares namespace std
+  # visible), which would then be exported and could bind to the host's copies; a version script keeps
+  # the entry symbol the only export.
+  set(exports "${CMAKE_CURRENT_BINARY_DIR}/impetus_plugin.exports")
+  file(CONFIGURE OUTPUT "${exports}" CONTENT "{ global: impetus_plugin_descriptor; local: *; };\n")
+  target_link_options(${target} PRIVATE "LINKER:--version-script=${exports}")
+  set_property(TARGET ${target} APPEND PROPERTY LINK_DEPENDS "${exports}")
   if(DEFINED IMPETUS_PLUGIN_OUTPUT_DIRECTORY)
     set_target_properties(${target} PROPERTIES LIBRARY_OUTPUT_DIRECTORY "${IMPETUS_PLUGIN_OUTPUT_DIRECTORY}")
   endif()

@@ -1,1 +1,226 @@
-int main() { return 0; }
+// The `impetus` command-line tool: run a scene, resolve one impact, list plugins.
+// Contract: shared/DESIGN.md, "Command-line contract"; README.md documents every option.
+
+#include "report.hpp"
+
+#include "impetus/core/error.hpp"
+#include "impetus/core/scene.hpp"
+#include "impetus/plugins/host.hpp"
+
+#include <CLI/CLI.hpp>
+
+#include <unistd.h>
+
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <iostream>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace fs = std::filesystem;
+using namespace impetus;
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+struct SceneArgs {
+  std::string scene;
+  std::vector<std::string> sets;
+  std::string integrator, detector, resolver;
+  std::optional<double> dt;
+};
+
+// The bundled demo: installed copy first (relative to this executable), then the source tree.
+fs::path demo_scene() {
+  std::error_code ec;
+  const fs::path exe = fs::read_symlink("/proc/self/exe", ec);
+  if (!ec) {
+    const fs::path installed = exe.parent_path() / IMPETUS_DEMO_SCENE_INSTALLED;
+    if (fs::exists(installed, ec)) return installed.lexically_normal();
+  }
+  return IMPETUS_DEMO_SCENE_BUILD;
+}
+
+// Command-line module and dt flags are overrides like any --set, applied before validation.
+Scene load(const SceneArgs& args) {
+  std::vector<SceneOverride> overrides;
+  if (args.dt) overrides.push_back({"dt", std::to_string(*args.dt)});
+  if (!args.integrator.empty()) overrides.push_back({"modules.integrator", args.integrator});
+  if (!args.detector.empty()) overrides.push_back({"modules.detector", args.detector});
+  if (!args.resolver.empty()) overrides.push_back({"modules.resolver", args.resolver});
+  for (const std::string& s : args.sets) overrides.push_back(parse_override(s));
+  return load_scene(args.scene.empty() ? demo_scene() : fs::path(args.scene), overrides);
+}
+
+void add_scene_options(CLI::App* cmd, SceneArgs& args, bool scene_required) {
+  auto* scene = cmd->add_option("scene", args.scene, "scene file (YAML)")->check(CLI::ExistingFile);
+  if (scene_required) scene->required();
+  cmd->add_option("--set", args.sets, "override a scene value by its dotted path: KEY=VALUE (repeatable)")
+      ->type_name("KEY=VALUE");
+  cmd->add_option("--resolver", args.resolver, "resolver plugin (overrides modules.resolver)")->type_name("NAME");
+}
+
+// Progress on stderr, only for a person watching a terminal, at most ten updates a second.
+class Progress {
+ public:
+  explicit Progress(std::uint64_t total) : total_(total), enabled_(isatty(STDERR_FILENO) != 0) {}
+  void update(const World& world) {
+    if (!enabled_) return;
+    const auto now = Clock::now();
+    if (now - last_ < std::chrono::milliseconds(100)) return;
+    if (!shown_ && now - start_ < std::chrono::milliseconds(500)) return;  // short runs stay quiet
+    last_ = now;
+    shown_ = true;
+    std::fprintf(stderr, "\r  step %llu/%llu (%.0f%%), t = %.4g s ", static_cast<unsigned long long>(world.step_count()),
+                 static_cast<unsigned long long>(total_), 100.0 * world.step_count() / total_, world.time());
+    std::fflush(stderr);
+  }
+  void done() {
+    if (shown_) std::fprintf(stderr, "\r%60s\r", "");
+  }
+
+ private:
+  std::uint64_t total_;
+  bool enabled_;
+  bool shown_ = false;
+  Clock::time_point start_ = Clock::now(), last_{};
+};
+
+int run_command(const SceneArgs& args, std::optional<std::uint64_t> steps, std::optional<double> duration,
+                const std::string& out_file, bool overwrite, std::uint64_t every, bool json) {
+  const Scene scene = load(args);
+  PluginHost host;
+  std::unique_ptr<World> world = build_world(scene, host);
+  const double dt = world->settings().dt;
+  std::uint64_t total = 1000;
+  if (steps) total = *steps;
+  if (duration) {
+    if (!(*duration >= 0.0) || !std::isfinite(*duration))
+      throw Error("--duration: must be a non-negative number of seconds");
+    total = static_cast<std::uint64_t>(std::llround(*duration / dt));
+  }
+
+  std::optional<cli::TrajectoryWriter> writer;
+  if (!out_file.empty()) {
+    writer.emplace(out_file, overwrite);
+    writer->write(*world);
+  }
+  cli::RunStats stats(*world);
+  Progress progress(total);
+  const auto start = Clock::now();
+  for (std::uint64_t i = 0; i < total; ++i) {
+    stats.before_step(*world);
+    const StepStatus& status = world->step();
+    if (!status.ok) {
+      progress.done();
+      throw Error(scene.file.string() + ": " + status.message);
+    }
+    stats.add_step(*world, status);
+    if (writer && (world->step_count() % every == 0 || i + 1 == total)) writer->write(*world);
+    progress.update(*world);
+  }
+  progress.done();
+  const double wall = std::chrono::duration<double>(Clock::now() - start).count();
+  nlohmann::json summary = stats.summary(*world, wall);
+  summary["scene"] = scene.file.string();
+  summary["modules"] = {{"integrator", scene.integrator.plugin},
+                        {"detector", scene.detector.plugin},
+                        {"resolver", scene.resolver.plugin}};
+  if (json) {
+    std::cout << summary.dump(2) << "\n";
+  } else {
+    std::cout << "scene                 " << scene.file.string() << "\n"
+              << "modules               integrator " << scene.integrator.plugin << ", detector "
+              << scene.detector.plugin << ", resolver " << scene.resolver.plugin << "\n";
+    cli::print_summary(summary, std::cout);
+    if (!out_file.empty()) std::cout << "trajectory            " << out_file << "\n";
+  }
+  return 0;
+}
+
+int resolve_command(const SceneArgs& args, bool json) {
+  const Scene scene = load(args);
+  PluginHost host;
+  std::unique_ptr<World> world = build_world(scene, host);
+  if (!world->has_detector() || !world->has_resolver())
+    throw Error(scene.file.string() + ": resolve needs a detector and a resolver (modules.detector and "
+                "modules.resolver are 'none')");
+  const StepStatus& status = world->detect_and_resolve();
+  if (!status.ok) throw Error(scene.file.string() + ": " + status.message);
+  const nlohmann::json report = cli::resolve_report(*world, scene.resolver.plugin, status.profile.resolve);
+  if (json) {
+    std::cout << report.dump(2) << "\n";
+    return 0;
+  }
+  std::cout << "resolver " << scene.resolver.plugin << ": " << report["contacts"].size() << " contacts, "
+            << report["iterations"] << " rounds, " << status.profile.resolve << " s, residual "
+            << status.resolver.residual << " m/s\n";
+  for (const auto& c : report["contacts"])
+    std::cout << "  " << c["a"].get<std::string>() << " - " << c["b"].get<std::string>() << "  depth "
+              << c["depth"] << "  impulse " << c["impulse"] << "\n";
+  return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"impetus: rigid-body simulation with replaceable integrator, detector and resolver plugins"};
+  app.set_version_flag("--version", std::string("impetus ") + IMPETUS_VERSION);
+  app.require_subcommand(1);
+
+  SceneArgs run_args;
+  std::optional<std::uint64_t> steps;
+  std::optional<double> duration;
+  std::string out_file;
+  bool overwrite = false, run_json = false;
+  std::uint64_t every = 1;
+  auto* run = app.add_subcommand("run", "simulate a scene (no SCENE: the bundled demo) and print a summary");
+  add_scene_options(run, run_args, false);
+  auto* steps_opt = run->add_option("--steps", steps, "number of steps (default 1000)")->check(CLI::NonNegativeNumber);
+  run->add_option("--duration", duration, "simulated time in seconds")->excludes(steps_opt);
+  run->add_option("--dt", run_args.dt, "time step in seconds (overrides dt)")->check(CLI::PositiveNumber);
+  run->add_option("--integrator", run_args.integrator, "integrator plugin (overrides modules.integrator)")->type_name("NAME");
+  run->add_option("--detector", run_args.detector, "detector plugin (overrides modules.detector)")->type_name("NAME");
+  run->add_option("--out", out_file, "write the trajectory as CSV: step,time,body,x,y,z,qw,qx,qy,qz,vx,vy,vz,wx,wy,wz");
+  run->add_flag("--overwrite", overwrite, "allow --out to replace an existing file");
+  run->add_option("--every", every, "with --out: record every N-th step (default 1)")->check(CLI::PositiveNumber);
+  run->add_flag("--json", run_json, "print the summary as JSON");
+
+  SceneArgs resolve_args;
+  bool resolve_json = false;
+  auto* resolve = app.add_subcommand("resolve", "one detection and one resolution on the scene's initial state");
+  add_scene_options(resolve, resolve_args, true);
+  resolve->add_flag("--json", resolve_json, "print contacts, impulses and velocities as JSON");
+
+  bool plugins_json = false;
+  auto* plugins = app.add_subcommand("plugins", "list every plugin found and every library that failed to load");
+  plugins->add_flag("--json", plugins_json, "print the listing as JSON");
+
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    return app.exit(e);
+  }
+
+  try {
+    if (run->parsed()) return run_command(run_args, steps, duration, out_file, overwrite, every, run_json);
+    if (resolve->parsed()) return resolve_command(resolve_args, resolve_json);
+    if (plugins->parsed()) {
+      PluginHost host;
+      const PluginListing listing = host.discover();
+      if (plugins_json)
+        std::cout << cli::plugins_report(listing).dump(2) << "\n";
+      else
+        cli::print_plugins(listing, std::cout);
+      return 0;
+    }
+  } catch (const std::exception& e) {
+    std::cerr << "impetus: error: " << e.what() << "\n";
+    return 1;
+  }
+  return 0;
+}

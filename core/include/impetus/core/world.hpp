@@ -104,12 +104,21 @@ class World {
   void resolve(StepStatus& status);
   void sync_detector();
   bool check_finite(StepStatus& status, const char* stage);
+  void take_snapshot();
+  void restore_snapshot();
+
+  struct BodyState {
+    Vec3 position;
+    Mat3 rotation;
+    Vec3 velocity;
+    Vec3 angular_velocity;
+  };
 
   WorldSettings settings_;
   std::vector<RigidBody> bodies_;
   std::vector<Constraint> constraints_;
   std::vector<Contact> contacts_;
-  std::vector<RigidBody> snapshot_;  // state before the step, for rollback on NaN
+  std::vector<BodyState> snapshot_;  // state before the step, for rollback on NaN
   std::shared_ptr<Integrator> integrator_;
   std::shared_ptr<CollisionDetector> detector_;
   std::shared_ptr<CollisionResolver> resolver_;

@@ -77,17 +77,30 @@ class PluginHost {
   /// (listing the available plugins of that kind and the directories searched), dlopen failure (its
   /// text), missing entry symbol, ABI version or descriptor size mismatch, config word mismatch, wrong
   /// kind, name mismatch, duplicate name (two different libraries loaded for one kind and name), a
-  /// factory that fails (its message), or options the plugin does not know.
+  /// factory that fails (its message), or options the plugin does not know. Messages start with
+  /// `request.where` and name the file tried; plugins/README.md lists them all.
+  /// The kind is the function's (request.kind is ignored). With `request.file`, that file is loaded
+  /// whatever its name, and must declare `request.name` if one is given; by name, the first
+  /// `impetus_<kind>_<name>.so` in the search path is used (a broken one is an error, not skipped).
+  /// An already open library (same canonical path) is reused.
   std::shared_ptr<Integrator> create_integrator(const PluginRequest& request);
   std::shared_ptr<CollisionDetector> create_detector(const PluginRequest& request);
   std::shared_ptr<CollisionResolver> create_resolver(const PluginRequest& request);
 
-  /// Loads every `impetus_*.so` in the search path and reports what each is, or why it failed.
+  /// Loads every `impetus_*.so` in the search path and reports what each is, or why it failed. A file
+  /// named `impetus_<kind>_<name>.so` must declare that kind and name. A kind+name already found in an
+  /// earlier directory is listed as shadowed; found twice in one directory, the second file (files
+  /// reachable by name first, then by file name) is a failure. Libraries not in use are unloaded again.
   PluginListing discover();
 
  private:
   std::shared_ptr<void> create(const PluginRequest& request);
-  std::shared_ptr<LoadedLibrary> open(const std::filesystem::path& file, const PluginRequest& request);
+  // Opens `file` (or reuses it if already open) and runs the ABI checks; null with `reason` on failure.
+  std::shared_ptr<LoadedLibrary> load(const std::filesystem::path& file, std::string& reason);
+  // First `impetus_<kind>_<name>.so` in the search path; empty if none.
+  std::filesystem::path find_by_name(ModuleKind kind, const std::string& name) const;
+  // The "no such plugin" message: what was searched and which plugins of that kind exist.
+  std::string unknown_name_message(const PluginRequest& request);
 
   std::vector<std::filesystem::path> search_path_;
   std::map<std::filesystem::path, std::weak_ptr<LoadedLibrary>> open_;  // by canonical path

@@ -1,0 +1,66 @@
+#pragma once
+// Summaries and output files of the `impetus` tool: run statistics, the trajectory CSV, and the JSON
+// documents of `run --json`, `resolve --json` and `plugins --json`.
+
+#include "impetus/core/metrics.hpp"
+#include "impetus/core/world.hpp"
+#include "impetus/plugins/host.hpp"
+
+#include <nlohmann/json.hpp>
+
+#include <cstdint>
+#include <filesystem>
+#include <fstream>
+#include <string>
+
+namespace impetus::cli {
+
+/// Statistics gathered over a run, step by step.
+class RunStats {
+ public:
+  explicit RunStats(const World& world);
+  /// Call before world.step(): adds the momentum gravity will add over the step. With velocities
+  /// updated before positions, a free body's angular momentum about the origin changes by exactly
+  /// dt · x_before × m g, so the pre-step position is the one to use.
+  void before_step(const World& world);
+  /// Adds the step just taken (after world.step()).
+  void add_step(const World& world, const StepStatus& status);
+  /// The summary as JSON (units in key names: _s, _j, _m …).
+  nlohmann::json summary(const World& world, double wall_seconds) const;
+
+ private:
+  WorldMetrics initial_;
+  double total_mass_ = 0.0;
+  Vec3 gravity_impulse_ = Vec3::Zero();  // ∫ Σ m g dt: the linear momentum gravity adds
+  Vec3 gravity_moment_ = Vec3::Zero();   // ∫ Σ x × m g dt: the angular momentum gravity adds about 0
+  StepProfile time_;                     // summed over steps
+  std::uint64_t steps_ = 0, contacts_ = 0, max_contacts_ = 0, rounds_ = 0, max_rounds_ = 0;
+  std::uint64_t non_converged_ = 0, singular_ = 0, pulling_ = 0;
+  double max_penetration_ = 0.0, max_residual_ = 0.0;
+};
+
+/// Prints a run summary for people.
+void print_summary(const nlohmann::json& summary, std::ostream& out);
+
+/// Writes one CSV row per body per recorded step: step,time,body,x,y,z,qw,qx,qy,qz,vx,vy,vz,wx,wy,wz.
+/// Numbers use the shortest text that reads back to the same double, so the file is bit-exact.
+class TrajectoryWriter {
+ public:
+  /// Opens `file` for writing; refuses to replace an existing file unless `overwrite`.
+  TrajectoryWriter(const std::filesystem::path& file, bool overwrite);
+  void write(const World& world);
+
+ private:
+  std::filesystem::path file_;
+  std::ofstream out_;
+};
+
+/// The `resolve --json` document (shared/DESIGN.md, "Command-line contract").
+nlohmann::json resolve_report(const World& world, const std::string& resolver, double seconds);
+
+/// The `plugins --json` document.
+nlohmann::json plugins_report(const PluginListing& listing);
+/// Prints the plugin listing for people.
+void print_plugins(const PluginListing& listing, std::ostream& out);
+
+}  // namespace impetus::cli

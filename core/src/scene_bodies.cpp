@@ -1,0 +1,169 @@
+// `bodies:` entries: name, shape, mass properties, pose, velocities, material, collision filter.
+
+#include "impetus/core/mass.hpp"
+#include "scene_body_setup.hpp"
+#include "scene_internal.hpp"
+
+#include <Eigen/Eigenvalues>
+
+#include <cmath>
+#include <limits>
+
+namespace impetus::scene_detail {
+namespace {
+
+// The mesh pipeline (import, validation, Mirtich mass properties) is its own issue; until it lands a
+// mesh is read and checked like any shape and then refused with this one message.
+constexpr const char* kMeshUnavailable =
+    "mesh shapes need the asset pipeline, which this build does not have yet (issue: assets)";
+
+Shape read_shape(const SceneReader& r, const YAML::Node& node) {
+  const Fields shape(r, node, "shape", {"sphere", "box", "capsule", "cylinder", "plane", "mesh"});
+  if (shape.entries().empty())
+    r.fail(node, "shape needs one of: sphere, box, capsule, cylinder, plane, mesh");
+  if (shape.entries().size() > 1)
+    r.fail(shape.entries()[1].key_node, "shape has both '" + shape.entries()[0].key + "' and '" +
+                                            shape.entries()[1].key + "'; give exactly one");
+  const Fields::Entry& kind = shape.entries().front();
+  if (kind.key == "sphere") {
+    const Fields f(r, kind.value, "sphere", {"radius"});
+    return Sphere{r.positive(f.require("radius"), "radius")};
+  }
+  if (kind.key == "box") {
+    const Fields f(r, kind.value, "box", {"size"});
+    const YAML::Node& size_node = f.require("size");
+    const Vec3 size = r.vec3(size_node, "size");
+    if (!(size.minCoeff() > 0.0)) r.fail(size_node, "'size' must have three positive edge lengths");
+    return Box{size};
+  }
+  if (kind.key == "capsule") {
+    const Fields f(r, kind.value, "capsule", {"radius", "length"});
+    // A capsule of length 0 is a sphere: allowed. A cylinder needs a length.
+    return Capsule{r.positive(f.require("radius"), "radius"), r.non_negative(f.require("length"), "length")};
+  }
+  if (kind.key == "cylinder") {
+    const Fields f(r, kind.value, "cylinder", {"radius", "length"});
+    return Cylinder{r.positive(f.require("radius"), "radius"), r.positive(f.require("length"), "length")};
+  }
+  if (kind.key == "plane") {
+    const Fields f(r, kind.value, "plane", {"normal", "offset"});
+    const YAML::Node& normal_node = f.require("normal");
+    const Vec3 normal = r.vec3(normal_node, "normal");
+    if (normal.norm() == 0.0) r.fail(normal_node, "'normal' must not be the zero vector");
+    const YAML::Node* offset = f.find("offset");
+    return Plane{normal.normalized(), offset ? r.number(*offset, "offset") : 0.0};
+  }
+  const Fields f(r, kind.value, "mesh", {"file", "scale", "collision"});
+  MeshShape mesh;
+  mesh.file = r.resolve_path(r.string(f.require("file"), "file"));
+  if (const YAML::Node* scale = f.find("scale")) mesh.scale = r.positive(*scale, "scale");
+  if (const YAML::Node* collision = f.find("collision"))
+    mesh.collision = r.choice(*collision, "collision", {"convex", "triangles"}) == "convex"
+                         ? MeshCollision::convex
+                         : MeshCollision::triangles;
+  r.fail(kind.key_node, kMeshUnavailable);
+}
+
+// `inertia: [Ixx, Iyy, Izz]` (principal moments, body axes) or a symmetric 3×3 list of rows.
+Mat3 read_inertia(const SceneReader& r, const YAML::Node& node) {
+  Mat3 inertia = Mat3::Zero();
+  if (node.IsSequence() && node.size() == 3 && node[0].IsSequence()) {
+    for (int row = 0; row < 3; ++row) {
+      const std::vector<double> values = r.numbers(node[row], "inertia", 3);
+      for (int col = 0; col < 3; ++col) inertia(row, col) = values[col];
+    }
+    const double scale = inertia.cwiseAbs().maxCoeff();
+    if ((inertia - inertia.transpose()).cwiseAbs().maxCoeff() > 1e-12 * scale)
+      r.fail(node, "'inertia' must be a symmetric matrix");
+    inertia = 0.5 * (inertia + inertia.transpose());
+  } else {
+    const std::vector<double> moments = r.numbers(node, "inertia", 3);
+    inertia = Vec3(moments[0], moments[1], moments[2]).asDiagonal();
+  }
+  const Vec3 principal = Eigen::SelfAdjointEigenSolver<Mat3>(inertia, Eigen::EigenvaluesOnly).eigenvalues();
+  if (!(principal.minCoeff() > 0.0))
+    r.fail(node, "'inertia' must be positive definite; its principal moments are " +
+                     std::to_string(principal[0]) + ", " + std::to_string(principal[1]) + ", " +
+                     std::to_string(principal[2]));
+  // A real mass distribution has I1 + I2 ≥ I3 for its principal moments (ascending here).
+  if (principal[0] + principal[1] < principal[2] * (1.0 - 1e-9))
+    r.fail(node, "'inertia' is not that of any rigid body: its principal moments break I1 + I2 >= I3");
+  return inertia;
+}
+
+// `orientation: [w, x, y, z]`, normalized; the zero quaternion has no direction.
+Mat3 read_orientation(const SceneReader& r, const YAML::Node& node) {
+  const std::vector<double> q = r.numbers(node, "orientation", 4);
+  const Quat quat(q[0], q[1], q[2], q[3]);
+  if (quat.norm() == 0.0) r.fail(node, "'orientation' is the zero quaternion; give [w, x, y, z] with w, x, y, z not all 0");
+  return quat.normalized().toRotationMatrix();
+}
+
+// The body's name if it has a readable one, to name it in messages about its other keys.
+std::string context_name(const YAML::Node& node, std::size_t index) {
+  if (node.IsMap())
+    for (const auto& entry : node)
+      if (entry.first.IsScalar() && entry.first.Scalar() == "name" && entry.second.IsScalar())
+        return "body '" + entry.second.Scalar() + "'";
+  return "body #" + std::to_string(index + 1);
+}
+
+}  // namespace
+
+ReadBody read_body(const SceneReader& r, const YAML::Node& node, std::size_t index) {
+  const Fields f(r, node, context_name(node, index),
+                 {"name", "fixed", "shape", "mass", "density", "inertia", "position", "orientation", "velocity",
+                  "angular_velocity", "restitution", "friction", "collision_group", "collision_mask"});
+  ReadBody out;
+  RigidBody& body = out.body;
+  out.where = f.require("name");
+  body.name = r.string(out.where, "name");
+  if (body.name.empty()) r.fail(out.where, "'name' must not be empty");
+  const bool fixed = f.find("fixed") ? r.boolean(*f.find("fixed"), "fixed") : false;
+  const YAML::Node& shape_node = f.require("shape");
+  body.shape = read_shape(r, shape_node);
+
+  if (const YAML::Node* n = f.find("position")) body.position = r.vec3(*n, "position");
+  if (const YAML::Node* n = f.find("orientation")) body.rotation = read_orientation(r, *n);
+  if (const YAML::Node* n = f.find("velocity")) body.velocity = r.vec3(*n, "velocity");
+  if (const YAML::Node* n = f.find("angular_velocity")) body.angular_velocity = r.vec3(*n, "angular_velocity");
+  if (const YAML::Node* n = f.find("restitution")) body.material.restitution = r.in_range(*n, "restitution", 0.0, 1.0);
+  if (const YAML::Node* n = f.find("friction")) body.material.friction = r.non_negative(*n, "friction");
+  constexpr long long kMaxBits = std::numeric_limits<std::uint32_t>::max();
+  if (const YAML::Node* n = f.find("collision_group"))
+    body.collision_group = static_cast<std::uint32_t>(r.integer(*n, "collision_group", 0, kMaxBits));
+  if (const YAML::Node* n = f.find("collision_mask"))
+    body.collision_mask = static_cast<std::uint32_t>(r.integer(*n, "collision_mask", 0, kMaxBits));
+
+  const YAML::Node* mass = f.find("mass");
+  const YAML::Node* density = f.find("density");
+  const YAML::Node* inertia = f.find("inertia");
+  if (fixed) {
+    // A fixed body's mass is infinite and it never moves: these keys would be silently ignored.
+    for (const char* key : {"mass", "density", "inertia", "velocity", "angular_velocity"})
+      if (const YAML::Node* n = f.find(key))
+        r.fail(*n, "'" + std::string(key) + "' does not apply to a fixed body (infinite mass, never moves)");
+    make_fixed(body);
+    return out;
+  }
+  if (std::holds_alternative<Plane>(body.shape))
+    r.fail(shape_node, "a plane is only allowed on a fixed body; add 'fixed: true' to " + f.context());
+  if (mass && density) r.fail(*density, "give either 'mass' or 'density', not both");
+  if (!mass && !density) r.fail(node, f.context() + " needs 'mass' or 'density' (it is not fixed)");
+  MassSpec spec;
+  if (mass) spec.mass = r.positive(*mass, "mass");
+  if (density) spec.density = r.positive(*density, "density");
+  if (inertia) spec.inertia_body = read_inertia(r, *inertia);
+  // Planes and meshes were refused above, so the shape is a primitive with a closed form.
+  const std::optional<UnitMassProperties> unit = primitive_mass_properties(body.shape);
+  if (!unit || !(unit->volume > 0.0) || !std::isfinite(unit->volume))
+    r.fail(shape_node, "the shape has no finite, positive volume, so it cannot carry a mass");
+  set_mass_properties(body, *unit, spec);
+  // Extreme but finite inputs can still overflow or underflow (1e300 kg, 1e-200 m).
+  if (!std::isfinite(body.mass) || !(body.inv_mass > 0.0) || !std::isfinite(body.inv_mass) ||
+      !body.inertia_body.allFinite() || !body.inv_inertia_body.allFinite())
+    r.fail(mass ? *mass : *density, "the mass properties of " + f.context() + " are not finite numbers");
+  return out;
+}
+
+}  // namespace impetus::scene_detail

@@ -1,0 +1,22 @@
+// Mass properties of a movable body from mass or density (see scene_body_setup.hpp).
+
+#include "scene_body_setup.hpp"
+
+#include <cassert>
+
+namespace impetus::scene_detail {
+
+void set_mass_properties(RigidBody& body, const UnitMassProperties& unit, const MassSpec& spec) {
+  assert(spec.mass.has_value() != spec.density.has_value());
+  assert(unit.volume > 0.0);
+  const double density = spec.density ? *spec.density : *spec.mass / unit.volume;
+  body.fixed = false;
+  body.mass = spec.mass ? *spec.mass : density * unit.volume;
+  body.inv_mass = 1.0 / body.mass;
+  body.inertia_body = spec.inertia_body ? *spec.inertia_body : Mat3(unit.inertia_per_density * density);
+  // Symmetrize: the cofactor inverse of a symmetric matrix can differ from symmetric in the last bit.
+  const Mat3 inverse = body.inertia_body.inverse();
+  body.inv_inertia_body = 0.5 * (inverse + inverse.transpose());
+}
+
+}  // namespace impetus::scene_detail

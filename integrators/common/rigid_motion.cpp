@@ -1,0 +1,30 @@
+#include "common/rigid_motion.hpp"
+
+namespace impetus::integrators {
+
+RotationSettings RotationSettings::from_options(const ModuleOptions& options) {
+  RotationSettings settings;
+  settings.orthonormalize = options.boolean("orthonormalize", settings.orthonormalize);
+  return settings;
+}
+
+void integrate_velocity(RigidBody& body, const StepContext& ctx) {
+  // eq. (2), row 1: the force acts through the center of mass.
+  body.velocity += ctx.dt * (ctx.gravity + body.inv_mass * body.force);
+  // eq. (2), row 2.
+  body.angular_velocity += ctx.dt * (body.inv_inertia_world() * body.torque);
+}
+
+void advance_pose(RigidBody& body, double dt, const RotationSettings& settings,
+                  IntegratorCounters& counters) {
+  // eq. (2), row 3, with the velocity already updated (and resolved): symplectic Euler.
+  body.position += dt * body.velocity;
+  // eq. (2), row 4: rotate by |ω| dt about ω, in the world frame, hence the left product.
+  body.rotation = rotation_from_vector(dt * body.angular_velocity) * body.rotation;
+  if (settings.orthonormalize) {
+    body.rotation = orthonormalized(body.rotation);
+    ++counters.orthonormalized;
+  }
+}
+
+}  // namespace impetus::integrators

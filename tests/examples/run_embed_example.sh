@@ -1,0 +1,13 @@
+#!/usr/bin/env bash
+# usage: run_embed_example.sh BUILD_DIR EXAMPLE_SRC WORK_DIR
+set -euo pipefail
+build=$1 example=$2 work=$3
+rm -rf "$work"
+mkdir -p "$work"
+cmake --install "$build" --prefix "$work/staging" >/dev/null
+mv "$work/staging" "$work/prefix"   # relocated: nothing may point back at the staging path
+cmake -S "$example" -B "$work/build" -G Ninja -DCMAKE_PREFIX_PATH="$work/prefix" >/dev/null
+cmake --build "$work/build" >/dev/null
+"$work/build/embed" "$work/prefix/share/impetus/scenes/demo.yaml"
+"$work/prefix/bin/impetus" plugins | grep -q "$work/prefix/.*impetus_integrator_euler.so" || {
+  echo "installed impetus does not find its own plugins" >&2; "$work/prefix/bin/impetus" plugins >&2; exit 1; }
