@@ -183,10 +183,16 @@ void print_plugins(const PluginListing& listing, std::ostream& out) {
   out << "searched:\n";
   for (const auto& dir : listing.searched) out << "  " << dir.string() << "\n";
   out << "plugins:\n";
+  std::size_t name_width = 4, version_width = 7;
   for (const PluginInfo& p : listing.plugins) {
-    out << "  " << std::left << std::setw(11) << module_kind_name(p.kind) << std::setw(12) << p.name
-        << std::setw(8) << p.version << p.path.string() << (p.shadowed ? "  (shadowed)" : "") << "\n"
-        << "  " << std::string(31, ' ') << p.summary << "\n";
+    name_width = std::max(name_width, p.name.size());
+    version_width = std::max(version_width, p.version.size());
+  }
+  for (const PluginInfo& p : listing.plugins) {
+    out << "  " << std::left << std::setw(11) << module_kind_name(p.kind) << std::setw(static_cast<int>(name_width + 2))
+        << p.name << std::setw(static_cast<int>(version_width + 2)) << p.version << p.path.string()
+        << (p.shadowed ? "  (shadowed)" : "") << "\n"
+        << "  " << std::string(11 + name_width + 2 + version_width + 2, ' ') << p.summary << "\n";
   }
   if (listing.plugins.empty()) out << "  (none)\n";
   if (!listing.failures.empty()) {

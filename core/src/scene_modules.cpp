@@ -2,6 +2,8 @@
 
 #include "scene_internal.hpp"
 
+#include <optional>
+
 namespace impetus::scene_detail {
 namespace {
 
@@ -41,10 +43,10 @@ ModuleRequest read_module(const SceneReader& r, const YAML::Node* node, ModuleKi
   ModuleRequest request;
   request.plugin = default_plugin(kind);
   request.where = r.file() + " (default " + kind_name + ")";
-  const YAML::Node* plugin_node = nullptr;
+  std::optional<YAML::Node> plugin_node;  // a handle, not a pointer: the Fields below is scoped
   if (node && node->IsScalar()) {
     // Short form: `integrator: euler`.
-    plugin_node = node;
+    plugin_node.emplace(*node);
   } else if (node && node->IsMap()) {
     // Long form: `detector: {plugin: fcl, path: ./lib.so, margin: 1.0e-4}`; every other key is an option
     // the plugin checks itself. Without `plugin` the default plugin gets the options.
@@ -52,7 +54,7 @@ ModuleRequest read_module(const SceneReader& r, const YAML::Node* node, ModuleKi
     request.where = r.where(*node);
     for (const Fields::Entry& e : f.entries()) {
       if (e.key == "plugin") {
-        plugin_node = &e.value;
+        plugin_node.emplace(e.value);
       } else if (e.key == "path") {
         request.path = r.resolve_path(r.string(e.value, "path"));
         if (r.string(e.value, "path").empty()) r.fail(e.value, "'path' must not be empty");

@@ -1,0 +1,74 @@
+#pragma once
+/// \file
+/// The algebra every impulse resolver shares: one "row" per contact (or constraint direction), the
+/// matrix A = G M⁻¹ Gᵀ of the paper's eq. 6–7, the right-hand side of eq. 8, and applying impulses
+/// with eq. 3.
+///
+/// Sign convention (shared/DESIGN.md): a row has bodies a, b, a world point P and a unit direction n
+/// (out of a into b). Its velocity is v_n = (u_b − u_a)·n with u = v + ω × r. An impulse magnitude p
+/// acts −p n on a and +p n on b, so for body s with sign σ (−1 for a, +1 for b):
+///   Δv_s = σ p n / M_s,   Δω_s = σ p J_s⁻¹ (r_s × n)                          (eq. 3, sign fixed)
+/// and the rows' velocities change by A p with
+///   A_ik = Σ_{s shared by rows i, k} σ_{s,i} σ_{s,k} [ n_i·n_k / M_s + (r_{s,i} × n_i)·J_s⁻¹ (r_{s,k} × n_k) ]
+/// (eq. 7 with its indices read as DESIGN.md says: symmetric positive semi-definite). The inelastic
+/// condition v_n⁺ = 0 (eq. 4) is A p = b with b = −v_n⁻ (eq. 8 with the sign fixed).
+/// Fixed bodies (inverse mass and inertia zero) drop out of every term.
+
+#include "impetus/core/body.hpp"
+#include "impetus/modules/contact.hpp"
+
+#include <cstdint>
+#include <span>
+#include <vector>
+
+namespace impetus::resolution {
+
+/// The velocity-space description of one impulse direction between two bodies.
+struct ImpulseRow {
+  BodyIndex a = 0, b = 0;
+  Vec3 normal = Vec3::UnitZ();  ///< unit, out of a into b
+  Vec3 point = Vec3::Zero();    ///< world point where the impulse acts
+  double inv_mass_a = 0.0, inv_mass_b = 0.0;
+  Vec3 arm_a = Vec3::Zero(), arm_b = Vec3::Zero();  ///< r_s × n (m)
+  Vec3 turn_a = Vec3::Zero(), turn_b = Vec3::Zero(); ///< J_s⁻¹ (r_s × n) (1/(kg·m))
+  double restitution = 0.0;
+};
+
+/// Builds the row for a direction `normal` at `point` between bodies `ia` and `ib` of `bodies`.
+ImpulseRow make_row(std::span<const RigidBody> bodies, BodyIndex ia, BodyIndex ib, const Vec3& point,
+                    const Vec3& normal, double restitution = 0.0);
+
+/// The row of a contact, with the combined restitution of its bodies.
+ImpulseRow make_contact_row(std::span<const RigidBody> bodies, const Contact& contact);
+
+/// A_ik: how a unit impulse on row k changes the velocity of row i (eq. 7). Zero unless they share a
+/// movable body.
+double coupling(const ImpulseRow& i, const ImpulseRow& k);
+
+/// A_kk = 1/m_eff of a single row: n·n/M_a + (r_a×n)·J_a⁻¹(r_a×n) + the same for b.
+inline double self_coupling(const ImpulseRow& row) { return coupling(row, row); }
+
+/// v_n = (u_b − u_a)·n of the row at the bodies' current velocities (m/s; < 0 approaches).
+double row_velocity(const ImpulseRow& row, std::span<const RigidBody> bodies);
+
+/// Applies impulse magnitude `p` along the row (eq. 3): −p n on a, +p n on b. Fixed bodies unchanged.
+void apply_row_impulse(const ImpulseRow& row, double p, std::span<RigidBody> bodies);
+
+/// Groups rows into islands: rows connected through shared movable bodies (fixed bodies do not
+/// connect). Each island lists row indices in increasing order; islands are ordered by their first
+/// row. Deterministic.
+std::vector<std::vector<std::uint32_t>> find_islands(std::span<const ImpulseRow> rows,
+                                                     std::size_t body_count,
+                                                     std::span<const RigidBody> bodies);
+
+/// Quality of a resolved contact set, measured from the bodies' velocities after resolution.
+struct ContactResidual {
+  double max_approach = 0.0;         ///< max over rows of max(0, −v_n⁺) (m/s)
+  double complementarity = 0.0;      ///< max over rows of |p · v_n⁺| (N·m/s)
+};
+
+/// Measures the residual of `rows` with their applied impulse magnitudes `impulses`.
+ContactResidual measure_residual(std::span<const ImpulseRow> rows, std::span<const double> impulses,
+                                 std::span<const RigidBody> bodies);
+
+}  // namespace impetus::resolution
