@@ -12,7 +12,9 @@
 
 namespace impetus {
 
-/// Changes body velocities by impulses so that no contact approaches (and constraints hold).
+/// Changes body velocities by impulses so that no contact approaches (and constraints hold). A resolver
+/// may also correct penetration by moving positions directly, provided it leaves velocities (and so
+/// kinetic energy) untouched by that correction.
 class CollisionResolver {
  public:
   virtual ~CollisionResolver() = default;

@@ -1,0 +1,46 @@
+#pragma once
+/// \file
+/// Resting contact, shared by every impulse resolver (issue: resolvers, item 3).
+///
+/// With the default split step (velocities → detect → resolve → positions; shared/DESIGN.md, "The
+/// step") a resting body does not sink: the resolver removes the approach that gravity added before
+/// positions move. What remains is penetration that is already there (initial overlap, rounding,
+/// rotation of corners, the paper's step order). It is removed by a **position correction** that adds no
+/// kinetic energy: after the velocity solve, each resolver solves the same system once more for
+/// non-negative "pseudo-impulses" q whose displacement separates the bodies by
+///   target_k = correction · max(0, depth_k − slop)            (m, along n_k)
+/// using A q ≥ target, q ≥ 0, q·(A q − target) = 0 (A of eq. 7 maps pseudo-impulses to changes of
+/// separation, to first order in the displacement). The displacement moves positions and rotations
+/// directly (apply_row_displacement) and never touches velocities.
+///
+/// A bounce threshold stops jitter: an island whose fastest approach is slower than `bounce_threshold`
+/// gets e = 0. It is judged per island, not per contact, because in a simultaneous impact touching
+/// contacts (v_n = 0) carry the restitution phase too (Newton's cradle: (1 + e) p on every contact).
+
+#include "common/impulse_rows.hpp"
+#include "impetus/modules/options.hpp"
+
+namespace impetus::resolution {
+
+/// Resting-contact settings, read from a resolver's options.
+struct RestingSettings {
+  double slop = 1e-4;              ///< penetration left alone (m); option `slop`
+  double correction = 0.2;         ///< fraction of the remaining penetration removed per step, [0, 1]; option `correction`
+  double bounce_threshold = 0.05;  ///< approach speed below which restitution is not applied (m/s); option `bounce_threshold`
+
+  /// Reads `slop`, `correction`, `bounce_threshold`; throws OptionError for a bad value.
+  static RestingSettings from_options(const ModuleOptions& options);
+};
+
+/// The restitution applied at a row of an island whose fastest approach speed is `impact_speed`
+/// (m/s, ≥ 0): the row's coefficient, or 0 below the bounce threshold.
+double effective_restitution(const ImpulseRow& row, double impact_speed, const RestingSettings& settings);
+
+/// Separation (m along n) the position correction asks for at a contact of `depth` (m).
+double correction_target(double depth, const RestingSettings& settings);
+
+/// Moves the row's bodies apart by pseudo-impulse `q` (kg·m): Δx = σ q n / M, and R turned by
+/// σ q J⁻¹ (r × n) (Rodrigues). Velocities are unchanged. Fixed bodies do not move.
+void apply_row_displacement(const ImpulseRow& row, double q, std::span<RigidBody> bodies);
+
+}  // namespace impetus::resolution
