@@ -7,7 +7,7 @@ packages=(
   libeigen3-dev libfcl-dev libccd-dev libassimp-dev libyaml-cpp-dev
   libgtest-dev libgmock-dev libbenchmark-dev
   libcli11-dev nlohmann-json3-dev
-  binutils
+  binutils python3
 )
 
 as_root=()

@@ -1,6 +1,7 @@
-// The `impetus` command-line tool: run a scene, resolve one impact, list plugins.
+// The `impetus` command-line tool: run a scene, resolve one impact, list plugins, mass properties of a mesh.
 // Contract: shared/DESIGN.md, "Command-line contract"; README.md documents every option.
 
+#include "mass_command.hpp"
 #include "report.hpp"
 
 #include "impetus/core/error.hpp"
@@ -53,7 +54,9 @@ Scene load(const SceneArgs& args) {
   if (!args.detector.empty()) overrides.push_back({"modules.detector", args.detector});
   if (!args.resolver.empty()) overrides.push_back({"modules.resolver", args.resolver});
   for (const std::string& s : args.sets) overrides.push_back(parse_override(s));
-  return load_scene(args.scene.empty() ? demo_scene() : fs::path(args.scene), overrides);
+  Scene scene = load_scene(args.scene.empty() ? demo_scene() : fs::path(args.scene), overrides);
+  for (const std::string& warning : scene.warnings) std::cerr << "impetus: warning: " << warning << "\n";
+  return scene;
 }
 
 void add_scene_options(CLI::App* cmd, SceneArgs& args, bool scene_required) {
@@ -200,6 +203,9 @@ int main(int argc, char** argv) {
   auto* plugins = app.add_subcommand("plugins", "list every plugin found and every library that failed to load");
   plugins->add_flag("--json", plugins_json, "print the listing as JSON");
 
+  cli::MassArgs mass_args;
+  auto* mass = cli::add_mass_command(app, mass_args);
+
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -209,6 +215,7 @@ int main(int argc, char** argv) {
   try {
     if (run->parsed()) return run_command(run_args, steps, duration, out_file, overwrite, every, run_json);
     if (resolve->parsed()) return resolve_command(resolve_args, resolve_json);
+    if (mass->parsed()) return cli::run_mass_command(mass_args);
     if (plugins->parsed()) {
       PluginHost host;
       const PluginListing listing = host.discover();

@@ -108,7 +108,9 @@ Scene load_scene_text(const std::string& yaml, const std::string& name, const st
   try {
     YAML::Node root = YAML::Load(yaml);
     scene_detail::apply_overrides(root, overrides, reader);
-    return read_scene(reader, root);
+    Scene scene = read_scene(reader, root);
+    scene.warnings = reader.warnings();
+    return scene;
   } catch (const YAML::Exception& e) {
     // Malformed YAML (or a yaml-cpp failure while reading the tree): never crash, point at it.
     throw Error(reader.where(e.mark) + ": invalid YAML: " + e.msg);

@@ -1,5 +1,6 @@
 // `bodies:` entries: name, shape, mass properties, pose, velocities, material, collision filter.
 
+#include "impetus/assets/mesh_body.hpp"
 #include "impetus/core/mass.hpp"
 #include "scene_body_setup.hpp"
 #include "scene_internal.hpp"
@@ -11,11 +12,6 @@
 
 namespace impetus::scene_detail {
 namespace {
-
-// The mesh pipeline (import, validation, Mirtich mass properties) is its own issue; until it lands a
-// mesh is read and checked like any shape and then refused with this one message.
-constexpr const char* kMeshUnavailable =
-    "mesh shapes need the asset pipeline, which this build does not have yet (issue: assets)";
 
 Shape read_shape(const SceneReader& r, const YAML::Node& node) {
   const Fields shape(r, node, "shape", {"sphere", "box", "capsule", "cylinder", "plane", "mesh"});
@@ -53,15 +49,44 @@ Shape read_shape(const SceneReader& r, const YAML::Node& node) {
     const YAML::Node* offset = f.find("offset");
     return Plane{normal.normalized(), offset ? r.number(*offset, "offset") : 0.0};
   }
-  const Fields f(r, kind.value, "mesh", {"file", "scale", "collision"});
+  // A mesh: imported (once per file, scale and part in this scene), validated, moved so the body
+  // frame's origin is its center of mass (the body's `position` places that point), with its convex
+  // hull. Without `collision`, a convex mesh collides as its hull and any other as triangles.
+  const Fields f(r, kind.value, "mesh", {"file", "scale", "collision", "part"});
   MeshShape mesh;
-  mesh.file = r.resolve_path(r.string(f.require("file"), "file"));
+  const YAML::Node& file = f.require("file");
+  mesh.file = r.resolve_path(r.string(file, "file"));
   if (const YAML::Node* scale = f.find("scale")) mesh.scale = r.positive(*scale, "scale");
-  if (const YAML::Node* collision = f.find("collision"))
+  const YAML::Node* part = f.find("part");
+  const YAML::Node* collision = f.find("collision");
+  if (collision)
     mesh.collision = r.choice(*collision, "collision", {"convex", "triangles"}) == "convex"
                          ? MeshCollision::convex
                          : MeshCollision::triangles;
-  r.fail(kind.key_node, kMeshUnavailable);
+  assets::MeshCache::Entry entry;
+  try {
+    entry = r.meshes().load(mesh.file, mesh.scale, part ? r.string(*part, "part") : std::string());
+  } catch (const Error& e) {
+    r.fail(file, e.what());  // "<scene>:<line>:<col>: <mesh file>: <defect>"
+  }
+  if (entry.fresh)
+    for (const std::string& warning : entry.body->warnings) r.warn(file, warning);
+  mesh.mesh = entry.body->mesh;
+  mesh.hull = entry.body->hull;
+  if (!collision) mesh.collision = entry.body->convex ? MeshCollision::convex : MeshCollision::triangles;
+  if (mesh.collision == MeshCollision::convex && !mesh.hull)
+    r.fail(*collision, "'collision: convex' needs a convex hull, and this mesh has none; use 'triangles'");
+  return mesh;
+}
+
+// Volume and inertia per unit density: closed form for a primitive, Mirtich's for a mesh (computed
+// when the mesh was read; looked up by its geometry).
+std::optional<UnitMassProperties> unit_mass_properties(const SceneReader& r, const Shape& shape) {
+  const auto* mesh = std::get_if<MeshShape>(&shape);
+  if (!mesh) return primitive_mass_properties(shape);
+  const std::shared_ptr<const assets::MeshBody> body = r.meshes().find(mesh->mesh.get());
+  if (!body) return std::nullopt;
+  return UnitMassProperties{body->unit.volume, body->unit.inertia};
 }
 
 // `inertia: [Ixx, Iyy, Izz]` (principal moments, body axes) or a symmetric 3×3 list of rows.
@@ -154,8 +179,8 @@ ReadBody read_body(const SceneReader& r, const YAML::Node& node, std::size_t ind
   if (mass) spec.mass = r.positive(*mass, "mass");
   if (density) spec.density = r.positive(*density, "density");
   if (inertia) spec.inertia_body = read_inertia(r, *inertia);
-  // Planes and meshes were refused above, so the shape is a primitive with a closed form.
-  const std::optional<UnitMassProperties> unit = primitive_mass_properties(body.shape);
+  // Planes were refused above: the shape is a primitive with a closed form, or a validated mesh.
+  const std::optional<UnitMassProperties> unit = unit_mass_properties(r, body.shape);
   if (!unit || !(unit->volume > 0.0) || !std::isfinite(unit->volume))
     r.fail(shape_node, "the shape has no finite, positive volume, so it cannot carry a mass");
   set_mass_properties(body, *unit, spec);

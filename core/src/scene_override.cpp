@@ -5,6 +5,8 @@
 
 #include <algorithm>
 #include <cctype>
+#include <optional>
+#include <utility>
 
 namespace impetus {
 namespace scene_detail {
@@ -53,7 +55,8 @@ YAML::Node find_element(const YAML::Node& list, const std::string& segment, cons
           return body;
     throw Error(label + ": no body named '" + segment + "'");
   }
-  throw Error(label + ": '" + list_path + "' is a list; select an element by its index, not '" + segment + "'");
+  const std::string name = list_path.empty() ? "the scene" : "'" + list_path + "'";
+  throw Error(label + ": " + name + " is a list; select an element by its index, not '" + segment + "'");
 }
 
 }  // namespace

@@ -2,6 +2,9 @@
 
 #include "scene_reader.hpp"
 
+#include "impetus/assets/mesh_body.hpp"
+
+#include <algorithm>
 #include <cctype>
 #include <charconv>
 #include <cmath>
@@ -29,6 +32,35 @@ std::string format_number(double x) {
   return out.str();
 }
 
+// Levenshtein distance, for suggesting the key a typo meant.
+std::size_t edit_distance(std::string_view a, std::string_view b) {
+  std::vector<std::size_t> row(b.size() + 1);
+  for (std::size_t j = 0; j <= b.size(); ++j) row[j] = j;
+  for (std::size_t i = 1; i <= a.size(); ++i) {
+    std::size_t diagonal = row[0];
+    row[0] = i;
+    for (std::size_t j = 1; j <= b.size(); ++j) {
+      const std::size_t up = row[j];
+      row[j] = std::min({row[j] + 1, row[j - 1] + 1, diagonal + (a[i - 1] == b[j - 1] ? 0 : 1)});
+      diagonal = up;
+    }
+  }
+  return row[b.size()];
+}
+
+// "; did you mean 'gravity'?" for a near miss, and a hint for "key:value" written without the space
+// YAML needs after the colon.
+std::string unknown_key_hint(std::string_view key, std::initializer_list<std::string_view> allowed) {
+  if (key.find(':') != std::string_view::npos) return "; a ':' needs a space after it to separate key and value";
+  std::string_view best;
+  std::size_t best_distance = 3;  // more than two edits is not a typo
+  for (std::string_view a : allowed) {
+    const std::size_t d = edit_distance(key, a);
+    if (d < best_distance && d < a.size()) best = a, best_distance = d;
+  }
+  return best.empty() ? "" : "; did you mean '" + std::string(best) + "'?";
+}
+
 }  // namespace
 
 std::string SceneReader::where(const YAML::Mark& mark) const {
@@ -45,6 +77,15 @@ std::string SceneReader::where(const YAML::Node& node) const {
 
 void SceneReader::fail(const YAML::Node& node, const std::string& message) const {
   throw Error(where(node) + ": " + message);
+}
+
+void SceneReader::warn(const YAML::Node& node, const std::string& message) const {
+  warnings_.push_back(where(node) + ": " + message);
+}
+
+assets::MeshCache& SceneReader::meshes() const {
+  if (!meshes_) meshes_ = std::make_shared<assets::MeshCache>();
+  return *meshes_;
 }
 
 void SceneReader::mark_override(const YAML::Node& node, const std::string& key, bool recursive) {
@@ -190,7 +231,8 @@ Fields::Fields(const SceneReader& reader, const YAML::Node& map, std::string con
     bool known = allowed.size() == 0;
     for (std::string_view a : allowed) known = known || a == name;
     if (!known)
-      reader.fail(key, "unknown key " + quote(name) + " in " + context_ + "; expected one of: " + join(allowed));
+      reader.fail(key, "unknown key " + quote(name) + " in " + context_ + "; expected one of: " + join(allowed) +
+                           unknown_key_hint(name, allowed));
     // yaml-cpp keeps both entries of a repeated key; which one wins would be an accident.
     for (const Entry& e : entries_)
       if (e.key == name)

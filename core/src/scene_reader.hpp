@@ -10,10 +10,15 @@
 
 #include <filesystem>
 #include <initializer_list>
+#include <memory>
 #include <string>
 #include <string_view>
 #include <utility>
 #include <vector>
+
+namespace impetus::assets {
+class MeshCache;
+}
 
 namespace impetus::scene_detail {
 
@@ -65,9 +70,18 @@ class SceneReader {
   /// "'abc'", "a list", "a mapping" or "nothing": what a node holds, for "got …" in messages.
   static std::string describe(const YAML::Node& node);
 
+  /// Records the warning "<where(node)>: <message>" (the scene loader hands them to Scene::warnings).
+  void warn(const YAML::Node& node, const std::string& message) const;
+  const std::vector<std::string>& warnings() const { return warnings_; }
+  /// Meshes imported while reading this scene: bodies naming the same file and scale share one
+  /// import and one geometry (assets/mesh_body.hpp). Created on first use.
+  assets::MeshCache& meshes() const;
+
  private:
   std::string file_;
   std::filesystem::path base_dir_;
+  mutable std::vector<std::string> warnings_;
+  mutable std::shared_ptr<assets::MeshCache> meshes_;
   std::vector<std::pair<YAML::Node, std::string>> overridden_;  // node → "--set KEY", latest last
 };
 

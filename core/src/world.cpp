@@ -47,6 +47,15 @@ void validate_body(const RigidBody& body, std::size_t index) {
     throw Error(label + ": inertia must be symmetric positive definite with a matching inverse");
 }
 
+// The bodies a constraint joins and whether they still collide, whatever its kind.
+struct ConstraintEnds {
+  BodyIndex a, b;
+  bool collide;
+};
+ConstraintEnds ends_of(const Constraint& constraint) {
+  return std::visit([](const auto& c) { return ConstraintEnds{c.a, c.b, c.collide}; }, constraint);
+}
+
 }  // namespace
 
 World::World(WorldSettings settings) : settings_(std::move(settings)) {
@@ -68,7 +77,7 @@ BodyIndex World::add_body(RigidBody body) {
 }
 
 void World::add_constraint(Constraint constraint) {
-  const auto& pp = std::get<PointPointConstraint>(constraint);
+  const ConstraintEnds pp = ends_of(constraint);
   if (pp.a >= bodies_.size() || pp.b >= bodies_.size() || pp.a == pp.b)
     throw Error("constraint: bodies must be two different existing bodies, got indices " +
                 std::to_string(pp.a) + " and " + std::to_string(pp.b));
@@ -113,7 +122,7 @@ void World::sync_detector() {
   if (!detector_ || !detector_stale_) return;
   std::vector<BodyPair> excluded;
   for (const Constraint& c : constraints_) {
-    const auto& pp = std::get<PointPointConstraint>(c);
+    const ConstraintEnds pp = ends_of(c);
     if (!pp.collide) excluded.emplace_back(std::min(pp.a, pp.b), std::max(pp.a, pp.b));
   }
   std::sort(excluded.begin(), excluded.end());

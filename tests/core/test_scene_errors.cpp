@@ -11,7 +11,13 @@ using test::load_error;
 TEST(SceneErrors, UnknownTopLevelKeyListsTheAllowedKeys) {
   expect_error("dt: 0.001\ngraviti: [0, 0, -9.81]\n",
                "scene.yaml:2:1: unknown key 'graviti' in scene; expected one of: dt, gravity, step_order, "
-               "plugin_path, modules, bodies, generators, constraints");
+               "plugin_path, modules, bodies, generators, constraints; did you mean 'gravity'?");
+}
+
+TEST(SceneErrors, UnknownKeyHintsAtAMissingSpaceAfterTheColon) {
+  expect_error("bodies:\n  - {name: b, shape: {sphere: {radius:1}}, mass: 1}\n",
+               "scene.yaml:2:32: unknown key 'radius:1' in sphere; expected one of: radius; a ':' needs a space after "
+               "it to separate key and value");
 }
 
 TEST(SceneErrors, UnknownKeyInABodyNamesTheBody) {
@@ -175,12 +181,12 @@ TEST(SceneErrors, InertiaMustBeARigidBodyInertia) {
       "scene.yaml:2:63: 'inertia' must be a symmetric matrix");
 }
 
-TEST(SceneErrors, MeshIsReadThenRefusedUntilTheAssetPipelineExists) {
+TEST(SceneErrors, MeshKeysAreCheckedAndAMissingMeshFileIsLocated) {
   expect_error("bodies:\n  - {name: part, density: 7800, shape: {mesh: {file: part.obj, scael: 2}}}\n",
                "scene.yaml:2:64: unknown key 'scael' in mesh; expected one of: file, scale, collision");
+  // The mesh file is relative to the scene's directory (/scenes here); the message points at `file`.
   expect_error("bodies:\n  - {name: part, density: 7800, shape: {mesh: {file: part.obj, scale: 0.001}}}\n",
-               "scene.yaml:2:41: mesh shapes need the asset pipeline, which this build does not have yet "
-               "(issue: assets)");
+               "scene.yaml:2:54: ", "/scenes/part.obj");
 }
 
 TEST(SceneErrors, BadYamlSyntaxIsAnErrorNotACrash) {

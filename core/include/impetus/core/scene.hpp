@@ -40,6 +40,9 @@ struct Scene {
   std::vector<std::filesystem::path> plugin_path;  ///< extra plugin directories, highest precedence
   std::vector<RigidBody> bodies;
   std::vector<Constraint> constraints;
+  /// Load-time warnings, each "<file>:<line>:<col>: <what>" (e.g. a mesh wound inward and flipped, or
+  /// converted from centimetres); the CLI prints them on stderr.
+  std::vector<std::string> warnings;
 };
 
 /// Loads and validates a scene file, applying `overrides` first. Throws Error with file, line, column

@@ -59,12 +59,21 @@ enum class MeshCollision : std::uint8_t {
 };
 
 /// A mesh shape: the file it came from (for messages), its scale, and the imported geometry (shared
-/// between bodies that use the same file). `mesh` is null until the asset pipeline fills it.
+/// between bodies that use the same file). `mesh` is null until the asset pipeline fills it; the
+/// pipeline (assets/mesh_body.hpp) has moved it so the body frame's origin is its center of mass.
 struct MeshShape {
   std::filesystem::path file;
   double scale = 1.0;
   MeshCollision collision = MeshCollision::convex;
   std::shared_ptr<const TriangleMesh> mesh;
+  /// The convex hull of `mesh` (same frame; closed, outward, only hull vertices), filled by the asset
+  /// pipeline. Null for a shape built in code without one.
+  std::shared_ptr<const TriangleMesh> hull;
+
+  /// What a detector should collide: the hull for convex collision when there is one, else `mesh`.
+  const TriangleMesh* collision_mesh() const {
+    return collision == MeshCollision::convex && hull ? hull.get() : mesh.get();
+  }
 };
 
 /// One of the shape kinds above.

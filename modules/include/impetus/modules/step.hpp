@@ -42,6 +42,7 @@ struct ResolverCounters {
   std::uint64_t nan_caught = 0;        ///< non-finite results rejected
   double residual = 0.0;               ///< largest approach velocity left after resolving (m/s, ≥ 0)
   double complementarity_error = 0.0;  ///< largest |p · v_n⁺| over the contacts (N·m/s)
+  std::uint64_t energy_gain_events = 0;  ///< islands whose kinetic energy rose in an impact (mixed restitution)
 };
 
 }  // namespace impetus

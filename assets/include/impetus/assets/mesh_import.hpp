@@ -1,0 +1,71 @@
+#pragma once
+/// \file
+/// Mesh import through assimp 5.2: Wavefront OBJ, STL (ASCII and binary), PLY, OFF, glTF 2.0
+/// (.gltf/.glb), COLLADA and the other formats assimp reads. The result is the engine's own
+/// TriangleMesh: no assimp type crosses this header.
+///
+/// Conventions. Coordinates are taken in the file's own axes (no up-axis conversion: rotate a body
+/// with the scene's `orientation`). Lengths come out in metres: a file that states its unit (COLLADA
+/// `<unit meter=…>`, FBX `UnitScaleFactor`) is converted, with a warning; a file that carries no unit
+/// (OBJ, STL, PLY, OFF) is read as metres, and a warning suggests a scale when the mesh is more than
+/// 10 m across (a part in millimetres or centimetres). glTF is metres by its specification.
+/// Triangles are counter-clockwise seen from outside; polygons are triangulated, points and lines
+/// dropped (with a warning), and vertices at identical positions welded (assimp's
+/// aiProcess_JoinIdenticalVertices is not used: it keeps STL's per-facet vertices apart because their
+/// normals differ, and it merges within a tolerance rather than on equality).
+
+#include "impetus/core/shape.hpp"
+
+#include <cstdint>
+#include <filesystem>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace impetus::assets {
+
+/// What becomes of several meshes in one file.
+enum class PartMode : std::uint8_t {
+  merge,    ///< default: every mesh in the file, placed by its node transform, becomes one mesh
+  separate  ///< one part per scene-graph node that carries meshes (an OBJ object, a glTF node, …)
+};
+
+/// What becomes of a length unit the file states.
+enum class UnitMode : std::uint8_t {
+  convert,    ///< default: convert to metres (a warning says so)
+  as_written  ///< keep the numbers as written (a warning names the file's unit)
+};
+
+/// How to import a mesh file.
+struct ImportOptions {
+  /// Multiplies every coordinate after unit conversion (e.g. 0.001 for a unitless file in mm). > 0.
+  double scale = 1.0;
+  PartMode parts = PartMode::merge;
+  UnitMode units = UnitMode::convert;
+};
+
+/// One imported part: metres (after unit conversion and scale), the file's axes, welded vertices.
+struct ImportedPart {
+  std::string name;  ///< the node's name (may be empty; in merge mode the file's stem)
+  TriangleMesh mesh;
+};
+
+/// The result of importing one file.
+struct ImportedMesh {
+  std::filesystem::path file;
+  std::string format;                ///< assimp's importer, e.g. "Wavefront Object Importer"
+  std::optional<double> file_unit;   ///< metres per file unit, when the file states one
+  std::vector<ImportedPart> parts;   ///< one (merge) or one per node with meshes (separate)
+  std::vector<std::string> warnings; ///< complete sentences, each naming the file
+};
+
+/// Imports `file`. Throws Error("<file>: <problem>") when it cannot be opened, is empty, is a
+/// truncated binary STL, cannot be parsed, or holds no triangles. The mesh is not validated here
+/// (see mesh_validation.hpp).
+ImportedMesh import_mesh(const std::filesystem::path& file, const ImportOptions& options = {});
+
+/// Welds vertices at exactly equal positions (−0 equals +0; NaN never equals anything), renumbers
+/// the triangles, and drops vertices no triangle uses.
+void weld_identical_vertices(TriangleMesh& mesh);
+
+}  // namespace impetus::assets

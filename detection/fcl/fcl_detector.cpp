@@ -1,0 +1,307 @@
+#include "fcl_detector.hpp"
+
+#include "analytic.hpp"
+#include "broadphase.hpp"
+#include "fcl_queries.hpp"
+#include "manifold.hpp"
+#include "mesh_contacts.hpp"
+#include "shapes.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <exception>
+#include <map>
+#include <string>
+#include <tuple>
+#include <utility>
+
+namespace impetus {
+
+using namespace collision;
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double seconds(Clock::time_point from, Clock::time_point to) {
+  return std::chrono::duration<double>(to - from).count();
+}
+
+std::uint64_t pair_key(BodyIndex a, BodyIndex b) { return (static_cast<std::uint64_t>(a) << 32) | b; }
+
+bool is_rounded(ShapeKind k) { return k == ShapeKind::sphere || k == ShapeKind::capsule; }
+
+bool overlap(const Aabb& x, const Aabb& y) {
+  return (x.min.array() <= y.max.array()).all() && (y.min.array() <= x.max.array()).all();
+}
+
+Aabb grown(const Aabb& box, double by) { return {(box.min.array() - by).matrix(), (box.max.array() + by).matrix()}; }
+
+/// Why a body's primitive cannot be used ("" if it can).
+std::string size_problem(const ShapeGeometry& g) {
+  auto positive = [](double x) { return std::isfinite(x) && x > 0.0; };
+  switch (g.kind) {
+    case ShapeKind::sphere: return positive(g.radius) ? "" : "sphere radius must be positive";
+    case ShapeKind::box: return positive(g.half_extents.minCoeff()) ? "" : "box sizes must be positive";
+    case ShapeKind::capsule:
+    case ShapeKind::cylinder:
+      return positive(g.radius) && std::isfinite(g.half_length) && g.half_length >= 0.0
+                 ? ""
+                 : "radius must be positive and length non-negative";
+    case ShapeKind::plane: return g.plane_normal.allFinite() ? "" : "plane normal must be non-zero";
+    default: return "";
+  }
+}
+
+}  // namespace
+
+FclDetectorSettings FclDetectorSettings::from_options(const ModuleOptions& options) {
+  FclDetectorSettings s;
+  s.margin = options.number("margin", s.margin, 0.0, 1e3);
+  s.max_contacts_per_pair = static_cast<int>(options.integer("max_contacts_per_pair", s.max_contacts_per_pair, 1, 4));
+  s.merge_tolerance = options.number("merge_tolerance", s.merge_tolerance, 0.0, 0.5);
+  return s;
+}
+
+struct FclDetector::Impl {
+  struct Body {
+    ShapeGeometry geometry;
+    FclShapePtr fcl;  // null for planes
+    bool fixed = false;
+    std::uint32_t group = 0, mask = 0;
+  };
+
+  FclDetectorSettings settings;
+  PairSettings pair;
+  std::vector<Body> bodies;
+  std::vector<BodyIndex> movable, planes;
+  std::vector<std::uint64_t> excluded;  // sorted pair keys
+  std::vector<Aabb> boxes;              // tight world boxes grown by half the margin (fixed: once)
+  Broadphase broadphase;
+  std::vector<BodyPair> pairs;
+  std::vector<ManifoldPoint> points;
+  MeshContacts mesh;
+  FclDetectorProfile profile;
+  bool ready = false;
+
+  using MeshCache =
+      std::map<std::pair<const TriangleMesh*, bool>, std::pair<std::shared_ptr<const MeshData>, FclShapePtr>>;
+
+  Placed placed(const RigidBody& body, BodyIndex i) const {
+    return {&bodies[i].geometry, body.position, body.rotation};
+  }
+  ModuleStatus add_body(const RigidBody& body, BodyIndex index, MeshCache& meshes);
+  bool filtered(BodyIndex a, BodyIndex b) const;
+  void narrow(const Placed& a, const Placed& b, const Body& ba, const Body& bb);
+  std::uint64_t finish_pair(BodyIndex a, BodyIndex b, double scale, std::vector<Contact>& contacts);
+};
+
+bool FclDetector::Impl::filtered(BodyIndex a, BodyIndex b) const {
+  const Body &ba = bodies[a], &bb = bodies[b];
+  if (ba.fixed && bb.fixed) return true;
+  if (!(ba.group & bb.mask) || !(bb.group & ba.mask)) return true;  // both ways must agree
+  return std::binary_search(excluded.begin(), excluded.end(), pair_key(a, b));
+}
+
+FclDetector::FclDetector(const ModuleOptions& options) : FclDetector(FclDetectorSettings::from_options(options)) {}
+
+FclDetector::FclDetector(const FclDetectorSettings& settings) : impl_(std::make_unique<Impl>()) {
+  impl_->settings = settings;
+  impl_->pair.margin = settings.margin;
+}
+
+FclDetector::~FclDetector() = default;
+
+const FclDetectorSettings& FclDetector::settings() const { return impl_->settings; }
+const FclDetectorProfile& FclDetector::last_profile() const { return impl_->profile; }
+
+ModuleStatus FclDetector::Impl::add_body(const RigidBody& body, BodyIndex index, MeshCache& meshes) {
+  const auto fail = [&](const std::string& why) {
+    return ModuleStatus::failure("body '" + body.name + "' (" + shape_kind_name(body.shape) + "): " + why);
+  };
+  Body entry;
+  entry.fixed = body.fixed;
+  entry.group = body.collision_group;
+  entry.mask = body.collision_mask;
+  try {
+    if (const auto* mesh = std::get_if<MeshShape>(&body.shape)) {
+      // Convex collision uses the hull the asset pipeline computed, when there is one.
+      const bool convex = mesh->collision == MeshCollision::convex;
+      const TriangleMesh* geometry = mesh->collision_mesh();
+      if (!geometry) return fail("mesh '" + mesh->file.string() + "' has no geometry (it was not imported)");
+      auto& cached = meshes[{geometry, convex}];
+      if (!cached.first) {
+        if (const std::string why = mesh_problem(*geometry, convex); !why.empty())
+          return fail("mesh '" + mesh->file.string() + "' " + why);
+        cached.first = make_mesh_data(*geometry, convex);
+        cached.second = make_fcl_shape(make_geometry(body.shape, cached.first));
+      }
+      entry.geometry = make_geometry(body.shape, cached.first);
+      entry.fcl = cached.second;
+    } else {
+      entry.geometry = make_geometry(body.shape, nullptr);
+      if (const std::string why = size_problem(entry.geometry); !why.empty()) return fail(why);
+      if (entry.geometry.kind == ShapeKind::plane && !body.fixed) return fail("a plane must be fixed");
+      if (entry.geometry.kind != ShapeKind::plane) entry.fcl = make_fcl_shape(entry.geometry);
+    }
+  } catch (const std::exception& e) {
+    return fail(std::string("FCL rejected its geometry: ") + e.what());
+  }
+  if (!body.position.allFinite() || !body.rotation.allFinite()) return fail("its pose is not finite");
+  bodies.push_back(std::move(entry));
+  if (bodies.back().geometry.kind == ShapeKind::plane) {
+    planes.push_back(index);  // planes never enter a tree: they are tested against the boxes directly
+    return ModuleStatus::success();
+  }
+  if (!body.fixed) movable.push_back(index);
+  boxes[index] = grown(world_aabb(placed(body, index)), 0.5 * settings.margin);
+  broadphase.add(index, bodies.back().fcl, body.fixed, boxes[index]);
+  return ModuleStatus::success();
+}
+
+ModuleStatus FclDetector::set_bodies(std::span<const RigidBody> bodies, std::span<const BodyPair> excluded) noexcept {
+  Impl& s = *impl_;
+  s.ready = false;
+  s.bodies.clear();
+  s.movable.clear();
+  s.planes.clear();
+  s.broadphase.clear();
+  s.boxes.assign(bodies.size(), Aabb{Vec3::Zero(), Vec3::Zero()});
+  try {
+    Impl::MeshCache meshes;  // bodies sharing one mesh share its derived data and FCL geometry
+    for (std::size_t i = 0; i < bodies.size(); ++i)
+      if (ModuleStatus status = s.add_body(bodies[i], static_cast<BodyIndex>(i), meshes); !status) return status;
+    s.broadphase.finish();
+    s.excluded.clear();
+    for (const BodyPair& p : excluded)
+      s.excluded.push_back(pair_key(std::min(p.first, p.second), std::max(p.first, p.second)));
+    std::sort(s.excluded.begin(), s.excluded.end());
+  } catch (const std::exception& e) {  // allocation failure
+    return ModuleStatus::failure(std::string("detector set-up failed: ") + e.what());
+  }
+  s.ready = true;
+  return ModuleStatus::success();
+}
+
+void FclDetector::detect(std::span<const RigidBody> bodies, const StepContext& /*ctx*/, std::vector<Contact>& contacts,
+                         DetectorCounters& counters) noexcept {
+  Impl& s = *impl_;
+  contacts.clear();
+  s.profile = FclDetectorProfile{};
+  if (!s.ready || bodies.size() != s.bodies.size()) return;  // set_bodies() was not called for these bodies
+  const double margin = s.settings.margin;
+  const auto start = Clock::now();
+
+  // 1. Broadphase: refresh the movable bodies' boxes (grown by half the margin each, so a gap up to the
+  // margin still overlaps), traverse the trees (fattened boxes: a superset), test the planes, keep the
+  // pairs whose exact boxes overlap and that pass the filters, sort.
+  s.pairs.clear();
+  for (BodyIndex i : s.movable) {
+    const Placed body = s.placed(bodies[i], i);
+    if (!body.x.allFinite() || !body.R.allFinite()) continue;  // the world rolls such a state back
+    s.boxes[i] = grown(world_aabb(body), 0.5 * margin);
+    s.broadphase.move(i, s.boxes[i], 0.05 * body.size());
+  }
+  s.broadphase.collect(s.pairs);
+  for (BodyIndex p : s.planes) {
+    const WorldPlane plane = world_plane(s.placed(bodies[p], p));
+    for (BodyIndex i : s.movable) {
+      const Vec3 center = 0.5 * (s.boxes[i].min + s.boxes[i].max), half = 0.5 * (s.boxes[i].max - s.boxes[i].min);
+      if (plane.normal.dot(center) - plane.normal.cwiseAbs().dot(half) <= plane.offset + 0.5 * margin)
+        s.pairs.emplace_back(std::min(i, p), std::max(i, p));
+    }
+  }
+  counters.pairs_tested += s.pairs.size();
+  std::erase_if(s.pairs, [&](const BodyPair& p) {
+    const bool planar =
+        s.bodies[p.first].geometry.kind == ShapeKind::plane || s.bodies[p.second].geometry.kind == ShapeKind::plane;
+    return (!planar && !overlap(s.boxes[p.first], s.boxes[p.second])) || s.filtered(p.first, p.second);
+  });
+  std::sort(s.pairs.begin(), s.pairs.end());
+  const auto broad_end = Clock::now();
+
+  // 2. Narrowphase: one manifold per pair, in pair order (so the list comes out sorted).
+  for (const auto& [a, b] : s.pairs) {
+    ++counters.narrowphase_calls;
+    const Placed pa = s.placed(bodies[a], a), pb = s.placed(bodies[b], b);
+    if (!pa.x.allFinite() || !pa.R.allFinite() || !pb.x.allFinite() || !pb.R.allFinite()) continue;
+    s.points.clear();
+    s.narrow(pa, pb, s.bodies[a], s.bodies[b]);
+    const double scale = pa.kind() == ShapeKind::plane   ? pb.size()
+                         : pb.kind() == ShapeKind::plane ? pa.size()
+                                                         : std::min(pa.size(), pb.size());
+    counters.contacts_dropped += s.finish_pair(a, b, scale, contacts);
+  }
+  counters.contacts += contacts.size();
+  const auto end = Clock::now();
+  s.profile.broadphase = seconds(start, broad_end);
+  s.profile.narrowphase = seconds(broad_end, end);
+}
+
+void FclDetector::Impl::narrow(const Placed& a, const Placed& b, const Body& ba, const Body& bb) {
+  const ShapeKind ka = a.kind(), kb = b.kind();
+  if (ka == ShapeKind::plane || kb == ShapeKind::plane) return halfspace_contacts(a, b, pair, points);
+  if (ka == ShapeKind::triangles && kb == ShapeKind::triangles)
+    return mesh.mesh_vs_mesh(a, *ba.fcl, b, *bb.fcl, pair, points, profile.fcl_failures);
+  if (ka == ShapeKind::triangles)
+    return mesh.mesh_vs_convex(a, *ba.fcl, b, *bb.fcl, true, pair, points, profile.fcl_failures);
+  if (kb == ShapeKind::triangles)
+    return mesh.mesh_vs_convex(b, *bb.fcl, a, *ba.fcl, false, pair, points, profile.fcl_failures);
+  if (is_rounded(ka) && is_rounded(kb)) return rounded_contacts(a, b, pair, points);
+  if ((ka == ShapeKind::sphere && kb == ShapeKind::box) || (ka == ShapeKind::box && kb == ShapeKind::sphere))
+    return sphere_box_contacts(a, b, pair, points);
+  if (ka == ShapeKind::box && kb == ShapeKind::box) {
+    const AxisResult axis = box_box_axis(a, b);
+    if (axis.overlap >= -settings.margin) convex_contacts(a, b, axis, pair, points);
+    return;
+  }
+  // Generic convex pair: FCL's signed distance gives the gap or the penetration with witness points;
+  // its normal is then checked and sharpened against the shapes' own face normals.
+  const SignedDistance sd = fcl_signed_distance(*ba.fcl, a, *bb.fcl, b);
+  if (!sd.ok) ++profile.fcl_failures;
+  if (sd.ok && sd.distance > settings.margin) return;
+  const double eps = 1e-12 * (a.size() + b.size());
+  Vec3 fcl_normal = Vec3::Zero();
+  if (sd.ok && sd.distance > eps) fcl_normal = (sd.on_b - sd.on_a).normalized();
+  else if (sd.ok && sd.distance < -eps) fcl_normal = (sd.on_a - sd.on_b).normalized();
+  const Vec3 centers = b.x - a.x;
+  const Vec3 hint = fcl_normal.allFinite() && !fcl_normal.isZero() ? fcl_normal
+                    : centers.norm() > eps                         ? Vec3(centers.normalized())
+                                                                   : Vec3(Vec3::UnitZ());
+  SmallVec<Vec3, 64> candidates;
+  candidate_axes(a, hint, b.x, candidates);
+  candidate_axes(b, hint, a.x, candidates);
+  candidates.push_back(hint);  // last: a face normal wins a tie
+  const AxisResult axis =
+      least_overlap_axis(a, b, {candidates.begin(), candidates.end()}, 1e-12 * (a.size() + b.size()));
+  if (axis.valid && axis.overlap >= -settings.margin) convex_contacts(a, b, axis, pair, points);
+}
+
+std::uint64_t FclDetector::Impl::finish_pair(BodyIndex a, BodyIndex b, double scale, std::vector<Contact>& contacts) {
+  std::uint64_t dropped = 0;
+  // A NaN or zero normal never reaches a resolver.
+  std::size_t kept = 0;
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    ManifoldPoint p = points[i];
+    const double len = p.normal.norm();
+    if (!p.point.allFinite() || !std::isfinite(p.depth) || !std::isfinite(len) || len < 1e-9) {
+      ++dropped;
+      continue;
+    }
+    p.normal /= len;
+    points[kept++] = p;
+  }
+  points.resize(kept);
+  dropped += merge_duplicates(points, settings.merge_tolerance * scale);
+  dropped += reduce_to_spanning(points, static_cast<std::size_t>(settings.max_contacts_per_pair));
+  // Pairs come in (a, b) order; sorting each manifold by (feature, point) makes the whole list sorted
+  // by (a, b, feature, point), independent of how the manifold was assembled.
+  std::sort(points.begin(), points.end(), [](const ManifoldPoint& l, const ManifoldPoint& r) {
+    return std::tie(l.feature, l.point.x(), l.point.y(), l.point.z()) <
+           std::tie(r.feature, r.point.x(), r.point.y(), r.point.z());
+  });
+  for (const ManifoldPoint& p : points) contacts.push_back(Contact{a, b, p.point, p.normal, p.depth, p.feature, 0.0});
+  return dropped;
+}
+
+}  // namespace impetus

@@ -1,0 +1,396 @@
+#include "ledas/ledas.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <string>
+#include <utility>
+
+namespace impetus {
+
+using ledas::RowIndex;
+using ledas::SparseMatrix;
+using ledas::Vector;
+using resolution::ImpulseRow;
+
+namespace {
+
+// Relative rounding below which a negative impulse is not counted as pulling, and an energy rise not
+// counted as a gain.
+constexpr double kRoundoff = 1e-12;
+// Position-correction problems are in metres; a violation below this is rounding.
+constexpr double kPositionTolerance = 1e-12;
+// Position-level joints are re-linearized round after round until the predicted gap is below this (m),
+// or stops halving.
+constexpr double kJointTolerance = 1e-9;
+
+// A of eq. 7 over an island's rows (local indices), both triangles stored. A_ik ≠ 0 only where rows i
+// and k share a movable body, so the pairs come from each body's list of rows.
+SparseMatrix assemble_matrix(std::span<const ImpulseRow> rows, std::span<const std::uint32_t> island,
+                             std::span<const RigidBody> bodies) {
+  std::vector<std::pair<BodyIndex, RowIndex>> touches;
+  for (std::size_t i = 0; i < island.size(); ++i) {
+    const ImpulseRow& r = rows[island[i]];
+    if (!bodies[r.a].fixed) touches.emplace_back(r.a, static_cast<RowIndex>(i));
+    if (!bodies[r.b].fixed && r.b != r.a) touches.emplace_back(r.b, static_cast<RowIndex>(i));
+  }
+  std::sort(touches.begin(), touches.end());
+  std::vector<std::pair<RowIndex, RowIndex>> pairs;
+  for (std::size_t begin = 0, end = 0; begin < touches.size(); begin = end) {
+    while (end < touches.size() && touches[end].first == touches[begin].first) ++end;
+    for (std::size_t i = begin; i < end; ++i)
+      for (std::size_t k = begin; k < end; ++k) pairs.emplace_back(touches[i].second, touches[k].second);
+  }
+  std::sort(pairs.begin(), pairs.end());  // rows sharing both bodies appear twice: coupling() sums both
+  pairs.erase(std::unique(pairs.begin(), pairs.end()), pairs.end());
+  std::vector<Eigen::Triplet<double>> entries;
+  entries.reserve(pairs.size());
+  for (auto [i, k] : pairs)
+    entries.emplace_back(static_cast<int>(i), static_cast<int>(k), resolution::coupling(rows[island[i]], rows[island[k]]));
+  const auto m = static_cast<Eigen::Index>(island.size());
+  SparseMatrix a(m, m);
+  a.setFromTriplets(entries.begin(), entries.end());
+  a.makeCompressed();
+  return a;
+}
+
+double kinetic_energy(std::span<const RigidBody> bodies, std::span<const BodyIndex> which) {
+  double e = 0.0;
+  for (BodyIndex i : which) {
+    const RigidBody& b = bodies[i];
+    e += 0.5 * b.mass * b.velocity.squaredNorm() + 0.5 * b.angular_velocity.dot(b.inertia_world() * b.angular_velocity);
+  }
+  return e;
+}
+
+bool valid_contact(const Contact& c, std::size_t body_count) {
+  return c.a < body_count && c.b < body_count && c.a != c.b && all_finite(c.point) && all_finite(c.normal) &&
+         std::isfinite(c.depth) && std::abs(c.normal.norm() - 1.0) < 1e-6;
+}
+
+}  // namespace
+
+/// One island's working data (local row i is global row rows[i]).
+struct LedasResolver::Island {
+  std::vector<std::uint32_t> rows;
+  SparseMatrix a;                  // eq. 7
+  std::vector<BodyIndex> bodies;   // movable bodies
+  std::vector<char> equality;      // joint rows
+  Vector target;                   // v_n⁺ bound: min(0, depth)/dt for contacts, RowInfo::target for joints
+  Vector restitution;              // effective e per row (0 for joint rows)
+  Vector impulse_inelastic;        // Σ p over rounds
+  Vector impulse_total;            // Σ (1 + e) p over rounds
+  std::vector<char> entered;       // the row took part in a system
+  double complementarity = 0.0;
+  std::uint64_t rounds = 0;
+  double dt = 0.0;
+  double joint_gap = std::numeric_limits<double>::infinity();  // last predicted position-joint gap (m)
+
+  Vector velocities(std::span<const ImpulseRow> all_rows, std::span<const ledas::RowInfo> info,
+                    std::span<const RigidBody> body_state) const {
+    Vector v(static_cast<Eigen::Index>(rows.size()));
+    for (std::size_t i = 0; i < rows.size(); ++i)
+      v(static_cast<Eigen::Index>(i)) = ledas::row_velocity(all_rows[rows[i]], info[rows[i]], body_state);
+    return v;
+  }
+};
+
+LedasSettings LedasSettings::from_options(const ModuleOptions& options) {
+  LedasSettings s;
+  s.mode = options.choice("mode", "complementary", {"paper", "complementary"}) == "paper" ? LedasMode::paper
+                                                                                         : LedasMode::complementary;
+  s.tolerance = options.number("tolerance", s.tolerance, 0.0, 1.0);
+  s.max_rounds = static_cast<std::uint64_t>(
+      options.integer("max_rounds", static_cast<long long>(s.max_rounds), 1, 1'000'000'000));
+  s.solver.dense_limit = static_cast<std::size_t>(
+      options.integer("dense_limit", static_cast<long long>(s.solver.dense_limit), 1, 100'000));
+  s.solver.rank_tolerance = options.number("rank_tolerance", s.solver.rank_tolerance, 1e-16, 1e-2);
+  s.solver.update_limit = static_cast<std::size_t>(
+      options.integer("update_limit", static_cast<long long>(s.solver.update_limit), 0, 10'000));
+  s.solver.max_iterations = s.max_rounds;
+  s.resting = resolution::RestingSettings::from_options(options);
+  return s;
+}
+
+LedasResolver::LedasResolver(const ModuleOptions& options) : LedasResolver(LedasSettings::from_options(options)) {}
+
+LedasResolver::LedasResolver(const LedasSettings& settings) : settings_(settings), solver_([&] {
+  ledas::SolverSettings s = settings.solver;
+  s.max_iterations = settings.max_rounds;
+  return s;
+}()) {}
+
+ModuleStatus LedasResolver::accept_constraints(std::span<const Constraint> constraints) noexcept {
+  for (std::size_t i = 0; i < constraints.size(); ++i) {
+    try {
+      if (std::string why = ledas::constraint_problem(constraints[i]); !why.empty())
+        return ModuleStatus::failure("constraint #" + std::to_string(i) + ": " + why);
+    } catch (...) {
+      return ModuleStatus::failure("constraint #" + std::to_string(i) + ": could not be checked");
+    }
+  }
+  return ModuleStatus::success();
+}
+
+void LedasResolver::resolve(std::span<RigidBody> bodies, std::span<Contact> contacts,
+                            std::span<const Constraint> constraints, const StepContext& ctx,
+                            ResolverCounters& counters) noexcept {
+  stats_ = LedasStats{};
+  try {
+    resolve_all(bodies, contacts, constraints, ctx, counters);
+  } catch (...) {  // out of memory: nothing may cross the plugin boundary; the step reports it
+    ++counters.non_converged;
+  }
+  counters.rounds += stats_.systems;
+  counters.pulling_impulses += stats_.pulling_applied + stats_.velocity.released;
+  counters.non_converged += stats_.velocity.non_converged + stats_.position.non_converged;
+  counters.singular_systems += stats_.velocity.singular + stats_.position.singular;
+  counters.nan_caught += stats_.velocity.nan_caught + stats_.position.nan_caught;
+}
+
+void LedasResolver::resolve_all(std::span<RigidBody> bodies, std::span<Contact> contacts,
+                                std::span<const Constraint> constraints, const StepContext& ctx,
+                                ResolverCounters& counters) {
+  rows_.clear();
+  info_.clear();
+  for (std::size_t k = 0; k < contacts.size(); ++k) {
+    Contact& c = contacts[k];
+    c.impulse = 0.0;
+    if (!valid_contact(c, bodies.size())) {
+      ++counters.nan_caught;
+      continue;
+    }
+    rows_.push_back(resolution::make_contact_row(bodies, c));
+    ledas::RowInfo ri;
+    ri.point_b = c.point;
+    ri.depth = c.depth;
+    ri.contact = static_cast<std::int64_t>(k);
+    info_.push_back(ri);
+  }
+  for (const Constraint& c : constraints) ledas::append_constraint_rows(bodies, c, ctx.dt, rows_, info_);
+
+  for (std::vector<std::uint32_t>& rows : resolution::find_islands(rows_, bodies.size(), bodies)) {
+    Island island = make_island(std::move(rows), bodies, ctx.dt);
+    const double energy_before = kinetic_energy(bodies, island.bodies);
+    if (settings_.mode == LedasMode::paper) velocity_paper(island, bodies, counters);
+    else velocity_complementary(island, bodies, counters);
+    const double energy_after = kinetic_energy(bodies, island.bodies);
+    stats_.kinetic_energy_change += energy_after - energy_before;
+    const bool bouncing = island.restitution.size() > 0 && island.restitution.maxCoeff() > 0.0;
+    if (bouncing && energy_after > energy_before * (1.0 + kRoundoff) + 1e-300) ++counters.energy_gain_events;
+
+    // Residual: the largest approach left below each contact's target, after the velocity phase.
+    const Vector v = island.velocities(rows_, info_, bodies);
+    for (std::size_t i = 0; i < island.rows.size(); ++i) {
+      const auto ei = static_cast<Eigen::Index>(i);
+      if (island.equality[i]) continue;
+      counters.residual = std::max(counters.residual, island.target(ei) - v(ei));
+      if (island.entered[i]) ++counters.contacts;
+      contacts[static_cast<std::size_t>(info_[island.rows[i]].contact)].impulse = island.impulse_total(ei);
+    }
+    counters.complementarity_error = std::max(counters.complementarity_error, island.complementarity);
+
+    correct_positions(island, bodies);
+    ++counters.islands;
+    ++stats_.islands;
+    stats_.largest_island = std::max(stats_.largest_island, island.rows.size());
+    stats_.rounds = std::max(stats_.rounds, island.rounds);
+  }
+}
+
+// An island's system: A (eq. 7), each row's target and restitution.
+LedasResolver::Island LedasResolver::make_island(std::vector<std::uint32_t> rows, std::span<const RigidBody> bodies,
+                                                 double dt) const {
+  Island island;
+  island.rows = std::move(rows);
+  island.dt = dt;
+  const std::size_t m = island.rows.size();
+  const auto em = static_cast<Eigen::Index>(m);
+  island.a = assemble_matrix(rows_, island.rows, bodies);
+  island.equality.resize(m);
+  island.target.resize(em);
+  island.restitution = Vector::Zero(em);
+  island.impulse_inelastic = Vector::Zero(em);
+  island.impulse_total = Vector::Zero(em);
+  island.entered.assign(m, 0);
+  for (std::size_t i = 0; i < m; ++i) {
+    const ImpulseRow& r = rows_[island.rows[i]];
+    const ledas::RowInfo& ri = info_[island.rows[i]];
+    island.equality[i] = ri.equality;
+    // Speculative gap: the contact may approach until the gap closes at the end of the step.
+    island.target(static_cast<Eigen::Index>(i)) = ri.equality ? ri.target : std::min(0.0, ri.depth) / dt;
+    for (BodyIndex body : {r.a, r.b})
+      if (!bodies[body].fixed) island.bodies.push_back(body);
+  }
+  std::sort(island.bodies.begin(), island.bodies.end());
+  island.bodies.erase(std::unique(island.bodies.begin(), island.bodies.end()), island.bodies.end());
+
+  // Restitution per island: the bounce threshold is judged on the island's fastest approach, because
+  // touching contacts carry the restitution phase too (resolution/common/resting.hpp).
+  const Vector v = island.velocities(rows_, info_, bodies);
+  double impact_speed = 0.0;
+  for (std::size_t i = 0; i < m; ++i) {
+    const auto ei = static_cast<Eigen::Index>(i);
+    if (!island.equality[i] && v(ei) <= island.target(ei) + settings_.tolerance)
+      impact_speed = std::max(impact_speed, -v(ei));
+  }
+  for (std::size_t i = 0; i < m; ++i)
+    if (!island.equality[i])
+      island.restitution(static_cast<Eigen::Index>(i)) =
+          resolution::effective_restitution(rows_[island.rows[i]], impact_speed, settings_.resting);
+  return island;
+}
+
+// The target a row is solved for this round. A gap contact that closes within the step and bounces
+// (e > 0) is an impact now: target 0, so (1 + e) p returns its full energy.
+namespace {
+double solve_target(double base_target, bool closing, double restitution) {
+  return closing && restitution > 0.0 ? 0.0 : base_target;
+}
+}  // namespace
+
+// Position-level joint rows (eqs. 9–10): the target v_n⁺ = v_n − s⁺/dt comes from a prediction at the
+// current velocities, linear in the impulse only to first order (eq. 2's rotation is not linear in ω).
+// Re-targeting at the start of every round makes the rounds a Newton-like iteration on the gap after
+// the step. Returns whether another round is worth it: the gap is above kJointTolerance and still
+// shrinking (by half at least; it shrinks by about |ω| dt per round).
+bool LedasResolver::retarget_joints(Island& island, const Vector& v, std::span<const RigidBody> bodies) const {
+  double gap = 0.0;
+  for (std::size_t i = 0; i < island.rows.size(); ++i) {
+    const ledas::RowInfo& ri = info_[island.rows[i]];
+    if (!ri.position_level) continue;
+    const double s = ledas::predicted_separation(rows_[island.rows[i]], ri, bodies, island.dt);
+    island.target(static_cast<Eigen::Index>(i)) = v(static_cast<Eigen::Index>(i)) - s / island.dt;
+    gap = std::max(gap, std::abs(s));
+  }
+  const bool refine = gap > kJointTolerance && gap < 0.5 * island.joint_gap;
+  island.joint_gap = gap;
+  return refine;
+}
+
+// The paper's rounds (sec. 3.2): only approaching contacts enter; A p = b as equalities; (1 + e) p;
+// re-check every contact; repeat until none approaches. Joint rows ride along in every round.
+void LedasResolver::velocity_paper(Island& island, std::span<RigidBody> bodies, ResolverCounters& counters) {
+  const std::size_t m = island.rows.size();
+  for (std::uint64_t round = 0;; ++round) {
+    const Vector v = island.velocities(rows_, info_, bodies);
+    const bool refine_joints = retarget_joints(island, v, bodies) && round > 0;
+    std::vector<RowIndex> subset;
+    bool approaching = false, joint_violated = false;
+    Vector target = island.target;
+    for (std::size_t i = 0; i < m; ++i) {
+      const auto ei = static_cast<Eigen::Index>(i);
+      if (island.equality[i]) {
+        joint_violated = joint_violated || std::abs(v(ei) - island.target(ei)) > settings_.tolerance;
+        subset.push_back(static_cast<RowIndex>(i));
+      } else if (v(ei) < island.target(ei) - settings_.tolerance) {  // approaching (or closing its gap)
+        approaching = true;
+        subset.push_back(static_cast<RowIndex>(i));
+        target(ei) = solve_target(island.target(ei), true, island.restitution(ei));
+      }
+    }
+    if (!approaching && !refine_joints && (round > 0 || !joint_violated)) break;
+    if (round == settings_.max_rounds) {
+      ++counters.non_converged;
+      break;
+    }
+    const Vector p = solver_.solve_subset(island.a, target - v, subset, stats_.velocity);
+    ++stats_.systems;
+    const double roundoff = kRoundoff * p.lpNorm<Eigen::Infinity>();
+    for (RowIndex i : subset)
+      if (!island.equality[i] && p(i) < -roundoff) ++stats_.pulling_applied;
+    for (RowIndex i : subset) island.entered[i] = 1;
+    finish_round(island, p, target, bodies);
+    ++island.rounds;
+  }
+}
+
+// The exact impact (a linear complementarity problem), then (1 + e) p. Restitution can make a contact
+// approach again (a separating contact pushed shut gets −e v_n⁻), so the round repeats while any does.
+void LedasResolver::velocity_complementary(Island& island, std::span<RigidBody> bodies, ResolverCounters& counters) {
+  const std::size_t m = island.rows.size();
+  ledas::ComplementarityProblem problem;
+  problem.matrix = &island.a;
+  problem.equality = island.equality;
+  problem.start.resize(m);
+  problem.tolerance = settings_.tolerance;
+  for (std::uint64_t round = 0;; ++round) {
+    const Vector v = island.velocities(rows_, info_, bodies);
+    bool needed = retarget_joints(island, v, bodies) && round > 0;
+    Vector target = island.target;
+    for (std::size_t i = 0; i < m; ++i) {
+      const auto ei = static_cast<Eigen::Index>(i);
+      if (island.equality[i]) {
+        problem.start[i] = 1;
+        needed = needed || (round == 0 && std::abs(v(ei) - island.target(ei)) > settings_.tolerance);
+        continue;
+      }
+      const bool touching = v(ei) <= island.target(ei) + settings_.tolerance;  // approaching or touching
+      problem.start[i] = touching;
+      needed = needed || v(ei) < island.target(ei) - settings_.tolerance;
+      target(ei) = solve_target(island.target(ei), touching, island.restitution(ei));
+      if (touching) island.entered[i] = 1;
+    }
+    if (!needed) break;
+    if (round == settings_.max_rounds) {
+      ++counters.non_converged;
+      break;
+    }
+    problem.rhs = target - v;
+    const std::uint64_t before = stats_.velocity.iterations;
+    const Vector p = solver_.solve_complementarity(problem, stats_.velocity);
+    stats_.systems += stats_.velocity.iterations - before;
+    for (std::size_t i = 0; i < m; ++i)
+      if (p(static_cast<Eigen::Index>(i)) != 0.0) island.entered[i] = 1;
+    finish_round(island, p, target, bodies);
+    ++island.rounds;
+  }
+}
+
+// Applies one round: the inelastic impulses p (eq. 3), measures complementarity on that state, then the
+// restitution phase e p (sec. 3.2: the total is (1 + e) p). Joint rows have e = 0.
+void LedasResolver::finish_round(Island& island, const Vector& p, const Vector& target, std::span<RigidBody> bodies) {
+  const std::size_t m = island.rows.size();
+  for (std::size_t i = 0; i < m; ++i) resolution::apply_row_impulse(rows_[island.rows[i]], p(static_cast<Eigen::Index>(i)), bodies);
+  island.impulse_inelastic += p;
+  const Vector v = island.velocities(rows_, info_, bodies);
+  island.complementarity = 0.0;
+  for (std::size_t i = 0; i < m; ++i) {
+    const auto ei = static_cast<Eigen::Index>(i);
+    if (!island.equality[i])
+      island.complementarity = std::max(island.complementarity, std::abs(island.impulse_inelastic(ei) * (v(ei) - target(ei))));
+  }
+  for (std::size_t i = 0; i < m; ++i) {
+    const auto ei = static_cast<Eigen::Index>(i);
+    if (island.restitution(ei) != 0.0)
+      resolution::apply_row_impulse(rows_[island.rows[i]], island.restitution(ei) * p(ei), bodies);
+    island.impulse_total(ei) += (1.0 + island.restitution(ei)) * p(ei);
+  }
+}
+
+// Resting contact (resolution/common/resting.hpp): pseudo-impulses q ≥ 0 with A q ≥ target and
+// complementarity move positions only; joint rows hold (target 0) so the correction does not drag them.
+void LedasResolver::correct_positions(Island& island, std::span<RigidBody> bodies) {
+  const std::size_t m = island.rows.size();
+  ledas::ComplementarityProblem problem;
+  problem.matrix = &island.a;
+  problem.equality = island.equality;
+  problem.start.resize(m);
+  problem.rhs = Vector::Zero(static_cast<Eigen::Index>(m));
+  problem.tolerance = kPositionTolerance;
+  bool needed = false;
+  for (std::size_t i = 0; i < m; ++i) {
+    if (island.equality[i]) continue;
+    const double t = resolution::correction_target(info_[island.rows[i]].depth, settings_.resting);
+    problem.rhs(static_cast<Eigen::Index>(i)) = t;
+    problem.start[i] = t > 0.0;
+    needed = needed || t > 0.0;
+  }
+  if (!needed) return;
+  const Vector q = solver_.solve_complementarity(problem, stats_.position);
+  for (std::size_t i = 0; i < m; ++i)
+    if (const double qi = q(static_cast<Eigen::Index>(i)); qi != 0.0)
+      resolution::apply_row_displacement(rows_[island.rows[i]], qi, bodies);
+}
+
+}  // namespace impetus

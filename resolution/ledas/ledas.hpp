@@ -1,0 +1,121 @@
+#pragma once
+/// \file
+/// The LEDAS simultaneous impulse resolver (Ermolin & Kazakov, shared/papers/ledas-simultaneous-impulses.md).
+/// README.md derives A and b with their signs, lists the paper's typos as fixed, and says what the
+/// method assumes, guarantees and where it fails.
+///
+/// Notation (resolution/common/impulse_rows.hpp): row k (a contact or a joint direction) has
+/// v_k = (u_b − u_a)·n_k (< 0 approaches); impulses p act −p n on a and +p n on b (eq. 3, sign fixed);
+/// the rows' velocities change by A p with A = G M⁻¹ Gᵀ (eq. 7), and eq. 4's inelastic condition is
+/// A p = b with b = target − v⁻ (eq. 8 with its sign fixed; target = 0 for a touching contact).
+
+#include "common/impulse_rows.hpp"
+#include "common/resting.hpp"
+#include "impetus/modules/options.hpp"
+#include "impetus/modules/resolver.hpp"
+#include "ledas/constraint_rows.hpp"
+#include "ledas/island_solver.hpp"
+
+#include <cstdint>
+#include <vector>
+
+namespace impetus {
+
+/// Which contacts enter the system and how it is solved.
+enum class LedasMode : std::uint8_t {
+  /// The paper's method (sec. 3.2) literally: only approaching contacts (v_n < −tolerance) enter;
+  /// A p = b is solved as equalities, (1 + e) p applied (eq. 3), every contact re-checked, and the
+  /// approaching ones solved again, round after round, until none approaches. Impulses may pull.
+  paper,
+  /// The frictionless inelastic impact solved exactly: approaching and touching contacts enter one
+  /// system; an active set releases pulling impulses and adds approaching contacts until p ≥ 0,
+  /// v_n⁺ ≥ 0, p·v_n⁺ = 0 at every contact (a linear complementarity problem); then (1 + e) p.
+  complementary
+};
+
+/// Configuration (read once from the plugin's options).
+struct LedasSettings {
+  LedasMode mode = LedasMode::complementary;  ///< option `mode: paper | complementary`
+  /// Touch tolerance (m/s): a contact approaches when v_n < target − tolerance and touches when
+  /// v_n ≤ target + tolerance. Option `tolerance`.
+  double tolerance = 1e-9;
+  /// Cap on rounds per island (paper mode; restitution rounds in complementary mode) and on active-set
+  /// iterations per complementarity problem; reaching it counts in non_converged. Option `max_rounds`.
+  std::uint64_t max_rounds = 1000000;
+  /// Options `dense_limit`, `rank_tolerance`, `update_limit` (max_iterations is set to max_rounds).
+  ledas::SolverSettings solver;
+  /// Options `slop`, `correction`, `bounce_threshold` (resolution/common/resting.hpp).
+  resolution::RestingSettings resting;
+
+  /// Reads every option above; throws OptionError for a bad value.
+  static LedasSettings from_options(const ModuleOptions& options);
+};
+
+/// What the last resolve() did, in more detail than ResolverCounters (for tests and benchmarks).
+struct LedasStats {
+  std::uint64_t islands = 0;         ///< islands solved
+  std::size_t largest_island = 0;    ///< rows of the largest island
+  std::uint64_t rounds = 0;          ///< most rounds in one island (paper: solve rounds; complementary: restitution rounds)
+  std::uint64_t systems = 0;         ///< linear systems solved in the velocity phase (= ResolverCounters::rounds)
+  std::uint64_t pulling_applied = 0; ///< paper mode: negative impulses applied
+  ledas::SolverStats velocity;       ///< the solver's counts in the velocity phase
+  ledas::SolverStats position;       ///< ... and in the position correction
+  double kinetic_energy_change = 0.0;  ///< Σ over islands of the velocity phase's ΔE_kin (J)
+};
+
+/// The LEDAS resolver: contacts and assembly constraints (point-point, coaxial) in one system per island.
+///
+/// Per island: (1) velocity phase by `mode`; (2) position correction: the complementarity problem
+/// A q ≥ correction_target(depth), q ≥ 0 (same solver, joints as equality rows with target 0), applied
+/// with resolution::apply_row_displacement (no velocity change). Contact::impulse gets each contact's
+/// total impulse Σ (1 + e) p (N·s).
+///
+/// Gap contacts (depth < 0, within the detector's margin) are speculative: a gap contact takes part only
+/// if it would close within the step (v_n·dt < depth) and then asks v_n⁺ ≥ depth/dt, so the gap closes
+/// exactly at the end of the step; with restitution (e > 0 after the bounce threshold) it asks v_n⁺ ≥ 0
+/// instead, so a bounce keeps its energy and turns back at most the margin early.
+///
+/// Counters: islands; contacts (that entered a system); rounds (linear systems solved in the velocity
+/// phase: rounds in paper mode, active-set iterations in complementary mode); pulling_impulses (paper:
+/// negative impulses applied; complementary: negative impulses released by the active set);
+/// non_converged; singular_systems (minimum-norm solutions); nan_caught (bad contacts, non-finite
+/// solutions); residual (largest v_n approach left below the target, m/s); complementarity_error
+/// (max |P·(v_n − target)| after the inelastic phase, P the total inelastic impulse); energy_gain_events
+/// (islands with restitution whose kinetic energy rose, possible only with mixed restitution).
+class LedasResolver final : public CollisionResolver {
+ public:
+  /// Reads the options; throws OptionError on a bad value.
+  explicit LedasResolver(const ModuleOptions& options);
+  /// Builds the resolver from settings directly (tests, embedding).
+  explicit LedasResolver(const LedasSettings& settings = {});
+
+  /// Accepts point-point and coaxial constraints at either level; refuses one with a bad axis or length.
+  ModuleStatus accept_constraints(std::span<const Constraint> constraints) noexcept override;
+
+  /// Resolves `contacts` and `constraints` (see the class comment), writing Contact::impulse.
+  void resolve(std::span<RigidBody> bodies, std::span<Contact> contacts, std::span<const Constraint> constraints,
+               const StepContext& ctx, ResolverCounters& counters) noexcept override;
+
+  const LedasSettings& settings() const { return settings_; }
+  /// Details of the last resolve().
+  const LedasStats& last_stats() const { return stats_; }
+
+ private:
+  struct Island;
+  void resolve_all(std::span<RigidBody> bodies, std::span<Contact> contacts, std::span<const Constraint> constraints,
+                   const StepContext& ctx, ResolverCounters& counters);
+  Island make_island(std::vector<std::uint32_t> rows, std::span<const RigidBody> bodies, double dt) const;
+  void velocity_paper(Island& island, std::span<RigidBody> bodies, ResolverCounters& counters);
+  void velocity_complementary(Island& island, std::span<RigidBody> bodies, ResolverCounters& counters);
+  bool retarget_joints(Island& island, const ledas::Vector& v, std::span<const RigidBody> bodies) const;
+  void finish_round(Island& island, const ledas::Vector& p, const ledas::Vector& target, std::span<RigidBody> bodies);
+  void correct_positions(Island& island, std::span<RigidBody> bodies);
+
+  LedasSettings settings_;
+  ledas::IslandSolver solver_;
+  LedasStats stats_;
+  std::vector<resolution::ImpulseRow> rows_;  // this step's rows: contacts first, then joint rows
+  std::vector<ledas::RowInfo> info_;
+};
+
+}  // namespace impetus

@@ -1,0 +1,222 @@
+#include "mirtich/mirtich.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <utility>
+#include <vector>
+
+namespace impetus {
+namespace {
+
+using resolution::ImpulseRow;
+
+// A pseudo-impulse pass whose largest change of separation is below this (m) has converged.
+constexpr double kPositionTolerance = 1e-11;
+
+// What the two passes share for one resolve() call. Arrays are indexed by contact (= row) index.
+struct Workspace {
+  std::vector<ImpulseRow> rows;
+  std::vector<double> a_kk;      // A_kk = 1/m_eff (eq. 7, i = k)
+  std::vector<double> vn;        // current v_n of each row (m/s), refreshed after every impulse
+  std::vector<double> impulse;   // accumulated p ≥ 0 (N·s)
+  std::vector<char> usable;      // false for rows whose A_kk is not a finite positive number
+  std::vector<std::vector<std::uint32_t>> rows_of_body;  // movable body → its rows
+  std::vector<std::size_t> local;  // row → its position in the island being corrected
+
+  // Every row sharing a movable body with row k (k included, each once), sorted.
+  std::vector<std::uint32_t> neighbours(std::uint32_t k) const {
+    std::vector<std::uint32_t> out;
+    for (BodyIndex s : {rows[k].a, rows[k].b})
+      out.insert(out.end(), rows_of_body[s].begin(), rows_of_body[s].end());
+    std::sort(out.begin(), out.end());
+    out.erase(std::unique(out.begin(), out.end()), out.end());
+    return out;
+  }
+};
+
+// Applies the single-contact impulse at row k, which approaches with v_n = ws.vn[k] < 0, and refreshes
+// v_n of every row that shares a body with it (recomputed from the velocities, so no drift builds up).
+// Returns false (and applies nothing) if the impulse is not finite.
+bool apply_single_impulse(std::uint32_t k, Workspace& ws, std::span<RigidBody> bodies,
+                          const MirtichSettings& settings, ResolverCounters& counters) {
+  const ImpulseRow& row = ws.rows[k];
+  // The impact speed is this contact's own approach speed: in a sequence of two-body collisions each
+  // one is a separate event (Newton's cradle: the next contact approaches at full speed only after the
+  // previous impulse). `ledas` judges the island as a whole instead; see README.md.
+  const double e = resolution::effective_restitution(row, -ws.vn[k], settings.resting);
+  const double p = -(1.0 + e) * ws.vn[k] / ws.a_kk[k];
+  if (!std::isfinite(p)) {
+    ++counters.nan_caught;
+    ws.usable[k] = 0;
+    return false;
+  }
+  resolution::apply_row_impulse(row, p, bodies);
+  ws.impulse[k] += p;
+  for (BodyIndex s : {row.a, row.b})
+    for (std::uint32_t i : ws.rows_of_body[s]) ws.vn[i] = resolution::row_velocity(ws.rows[i], bodies);
+  return true;
+}
+
+// The velocity sweep over one island. Returns the number of single impulses applied; `capped` tells
+// whether the sweep stopped at the cap with a contact still approaching.
+std::uint64_t sweep_island(const std::vector<std::uint32_t>& island, Workspace& ws, std::span<RigidBody> bodies,
+                           const MirtichSettings& settings, ResolverCounters& counters, bool& capped) {
+  const std::uint64_t cap = settings.impulse_cap(island.size());
+  const double tol = settings.tolerance;
+  const auto approaches = [&](std::uint32_t k) { return ws.usable[k] && ws.vn[k] < -tol; };
+  std::uint64_t applied = 0;
+  capped = false;
+  if (settings.order == MirtichOrder::most_approaching) {
+    for (;;) {
+      // Most negative v_n; the strict comparison keeps the lowest index among ties.
+      std::uint32_t best = 0;
+      double best_vn = -tol;
+      bool found = false;
+      for (std::uint32_t k : island) {
+        if (ws.usable[k] && ws.vn[k] < best_vn) {
+          best = k;
+          best_vn = ws.vn[k];
+          found = true;
+        }
+      }
+      if (!found) break;
+      if (applied >= cap) {
+        capped = true;
+        break;
+      }
+      if (apply_single_impulse(best, ws, bodies, settings, counters)) ++applied;
+    }
+    return applied;
+  }
+  // Index order: cyclic passes; stop after a whole pass in which nothing approached.
+  std::size_t quiet = 0;  // consecutive rows met without an impulse
+  for (std::size_t j = 0; quiet < island.size(); j = (j + 1) % island.size()) {
+    const std::uint32_t k = island[j];
+    if (!approaches(k)) {
+      ++quiet;
+      continue;
+    }
+    if (applied >= cap) {
+      capped = true;
+      break;
+    }
+    if (apply_single_impulse(k, ws, bodies, settings, counters)) {
+      ++applied;
+      quiet = 0;
+    } else {
+      ++quiet;
+    }
+  }
+  return applied;
+}
+
+// Position correction of one island (resting.hpp): projected Gauss–Seidel on pseudo-impulses q ≥ 0
+// with accumulated clamping for A q ≥ target, then one displacement per row. Velocities are untouched.
+void correct_island(const std::vector<std::uint32_t>& island, Workspace& ws, std::span<const Contact> contacts,
+                    std::span<RigidBody> bodies, const MirtichSettings& settings) {
+  std::vector<double> target(island.size());
+  bool any = false;
+  for (std::size_t j = 0; j < island.size(); ++j) {
+    target[j] = resolution::correction_target(contacts[island[j]].depth, settings.resting);
+    any = any || target[j] > 0.0;
+  }
+  if (!any) return;  // nothing penetrates beyond the slop: q = 0 is the solution
+
+  // Local indices and the sparse coupling of each row to the rows it shares a body with (eq. 7).
+  // Rows sharing a body are always in the same island, so `local` is only read where just written.
+  for (std::size_t j = 0; j < island.size(); ++j) ws.local[island[j]] = j;
+  std::vector<std::vector<std::pair<std::size_t, double>>> column(island.size());
+  for (std::size_t j = 0; j < island.size(); ++j)
+    for (std::uint32_t i : ws.neighbours(island[j]))
+      column[j].emplace_back(ws.local[i], resolution::coupling(ws.rows[i], ws.rows[island[j]]));
+
+  std::vector<double> q(island.size(), 0.0), separation(island.size(), 0.0);  // separation = A q (m)
+  for (int pass = 0; pass < settings.position_iterations; ++pass) {
+    double largest_change = 0.0;
+    for (std::size_t j = 0; j < island.size(); ++j) {
+      const std::uint32_t k = island[j];
+      if (!ws.usable[k]) continue;
+      const double q_new = std::max(0.0, q[j] + (target[j] - separation[j]) / ws.a_kk[k]);
+      const double dq = q_new - q[j];
+      if (dq == 0.0) continue;
+      q[j] = q_new;
+      for (const auto& [i, a_ik] : column[j]) separation[i] += a_ik * dq;
+      largest_change = std::max(largest_change, std::abs(dq) * ws.a_kk[k]);
+    }
+    if (largest_change < kPositionTolerance) break;
+  }
+  // All displacements use the rows built before the correction: first order in the (small) motion.
+  for (std::size_t j = 0; j < island.size(); ++j)
+    if (q[j] > 0.0) resolution::apply_row_displacement(ws.rows[island[j]], q[j], bodies);
+}
+
+}  // namespace
+
+MirtichSettings MirtichSettings::from_options(const ModuleOptions& options) {
+  MirtichSettings s;
+  s.order = options.choice("order", "most_approaching", {"most_approaching", "index"}) == "index"
+                ? MirtichOrder::index
+                : MirtichOrder::most_approaching;
+  s.tolerance = options.number("tolerance", s.tolerance, 0.0, 1e3);
+  s.max_impulses = static_cast<std::uint64_t>(options.integer("max_impulses", 0, 0, 1'000'000'000'000LL));
+  s.position_iterations = static_cast<int>(options.integer("position_iterations", s.position_iterations, 0, 100000));
+  s.resting = resolution::RestingSettings::from_options(options);
+  return s;
+}
+
+std::uint64_t MirtichSettings::impulse_cap(std::size_t contacts) const {
+  if (max_impulses > 0) return max_impulses;
+  return std::max<std::uint64_t>(10000, 100 * static_cast<std::uint64_t>(contacts));
+}
+
+MirtichResolver::MirtichResolver(const ModuleOptions& options) : settings_(MirtichSettings::from_options(options)) {}
+
+MirtichResolver::MirtichResolver(const MirtichSettings& settings) : settings_(settings) {}
+
+void MirtichResolver::resolve(std::span<RigidBody> bodies, std::span<Contact> contacts,
+                              std::span<const Constraint> /*constraints*/, const StepContext& /*ctx*/,
+                              ResolverCounters& counters) noexcept {
+  try {
+    Workspace ws;
+    const std::size_t m = contacts.size();
+    ws.rows.reserve(m);
+    for (const Contact& c : contacts) ws.rows.push_back(resolution::make_contact_row(bodies, c));
+    ws.a_kk.resize(m);
+    ws.vn.resize(m);
+    ws.impulse.assign(m, 0.0);
+    ws.usable.assign(m, 1);
+    ws.local.assign(m, 0);
+    ws.rows_of_body.resize(bodies.size());
+    for (std::uint32_t k = 0; k < m; ++k) {
+      const ImpulseRow& row = ws.rows[k];
+      ws.a_kk[k] = resolution::self_coupling(row);
+      ws.vn[k] = resolution::row_velocity(row, bodies);
+      if (!(ws.a_kk[k] > 0.0) || !std::isfinite(ws.a_kk[k])) {
+        ws.usable[k] = 0;  // e.g. a contact between two fixed bodies: no impulse can act on it
+        if (!bodies[row.a].fixed || !bodies[row.b].fixed) ++counters.singular_systems;
+      }
+      for (BodyIndex s : {row.a, row.b})
+        if (!bodies[s].fixed) ws.rows_of_body[s].push_back(k);
+    }
+
+    const auto islands = resolution::find_islands(ws.rows, bodies.size(), bodies);
+    for (const auto& island : islands) {
+      bool capped = false;
+      counters.rounds += sweep_island(island, ws, bodies, settings_, counters, capped);
+      if (capped) ++counters.non_converged;
+      ++counters.islands;
+      counters.contacts += island.size();
+    }
+    // Quality is measured after the velocity sweep; the position correction does not change velocities.
+    const resolution::ContactResidual residual = resolution::measure_residual(ws.rows, ws.impulse, bodies);
+    counters.residual = std::max(counters.residual, residual.max_approach);
+    counters.complementarity_error = std::max(counters.complementarity_error, residual.complementarity);
+    for (const auto& island : islands) correct_island(island, ws, contacts, bodies, settings_);
+    for (std::size_t k = 0; k < m; ++k) contacts[k].impulse = ws.impulse[k];
+  } catch (...) {
+    // Only allocation can throw here; report it as a failed (non-converged) resolution.
+    ++counters.non_converged;
+  }
+}
+
+}  // namespace impetus

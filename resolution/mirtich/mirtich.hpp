@@ -1,0 +1,84 @@
+#pragma once
+/// \file
+/// The sequential baseline resolver: one approaching contact at a time, each with the exact
+/// single-contact frictionless impulse (Mirtich 1996, the paper's reference [4]; the paper's sec. 1
+/// argues against it with Figure 1 and the "almost freezing" stacks). See README.md for what it
+/// assumes, guarantees and where it fails.
+///
+/// Notation (shared with resolution/common/impulse_rows.hpp): a contact k is a row with relative normal
+/// velocity v_k = (u_b − u_a)·n_k (< 0 approaches) and A_kk = 1/m_eff (eq. 7 for i = k). Its single
+/// impulse is
+///   p_k = −(1 + e_k) v_k / A_kk,
+/// which leaves v_k⁺ = −e_k v_k exactly (the paper's eq. 6 for m = 1, with the restitution of sec. 3.2).
+
+#include "common/impulse_rows.hpp"
+#include "common/resting.hpp"
+#include "impetus/modules/options.hpp"
+#include "impetus/modules/resolver.hpp"
+
+#include <cstdint>
+
+namespace impetus {
+
+/// Which approaching contact the sweep resolves next. Both are deterministic for a given contact order.
+enum class MirtichOrder : std::uint8_t {
+  /// The contact with the most negative v_n in its island; ties go to the lower contact index.
+  most_approaching,
+  /// Cyclic passes over the island's contacts in increasing contact index, resolving each approaching
+  /// one as it is met (Gauss–Seidel order).
+  index
+};
+
+/// Configuration of the sequential resolver (read once from the plugin's options).
+struct MirtichSettings {
+  MirtichOrder order = MirtichOrder::most_approaching;  ///< option `order: most_approaching | index`
+  /// A contact approaches when v_n < −tolerance (m/s); the sweep stops when none does. Option `tolerance`.
+  double tolerance = 1e-6;
+  /// Cap on single impulses per island; 0 means automatic: max(10000, 100 × contacts in the island).
+  /// Reaching it stops the sweep and counts the island in ResolverCounters::non_converged.
+  /// Option `max_impulses`.
+  std::uint64_t max_impulses = 0;
+  /// Cap on Gauss–Seidel passes of the position correction per island. Option `position_iterations`.
+  int position_iterations = 50;
+  /// Resting-contact settings: options `slop`, `correction`, `bounce_threshold`.
+  resolution::RestingSettings resting;
+
+  /// Reads every option above; throws OptionError for a bad value.
+  static MirtichSettings from_options(const ModuleOptions& options);
+  /// The impulse cap for an island of `contacts` contacts (max_impulses, or the automatic value).
+  std::uint64_t impulse_cap(std::size_t contacts) const;
+};
+
+/// Sequential frictionless impulses, island by island:
+///  1. velocity sweep: while some contact approaches (v_n < −tolerance) and the island's cap is not
+///     reached, pick one (MirtichOrder) and apply p = −(1 + e) v_n / A_kk with
+///     e = effective_restitution(row, −v_n of that contact, resting): each single collision gets its
+///     own impact speed (see README.md for why this differs from `ledas`);
+///  2. position correction: Gauss–Seidel on pseudo-impulses q ≥ 0 (projected, accumulated) so that
+///     A q ≥ correction_target(depth) with complementarity, then apply_row_displacement; velocities are
+///     not touched by it.
+/// Every applied impulse is ≥ 0, so `pulling_impulses` stays 0. Counters: islands, contacts (in
+/// islands), rounds (= single impulses), non_converged (islands that hit the cap), residual and
+/// complementarity_error (measure_residual after the sweep), nan_caught / singular_systems (contacts
+/// whose A_kk or impulse was not a finite positive number; they are skipped).
+class MirtichResolver final : public CollisionResolver {
+ public:
+  /// Reads the options; throws OptionError on a bad value.
+  explicit MirtichResolver(const ModuleOptions& options);
+  /// Builds the resolver from settings directly (tests, embedding).
+  explicit MirtichResolver(const MirtichSettings& settings);
+
+  /// Resolves `contacts` (constraints are refused by accept_constraints and ignored here), writing
+  /// each contact's total impulse (N·s, ≥ 0) into Contact::impulse.
+  void resolve(std::span<RigidBody> bodies, std::span<Contact> contacts,
+               std::span<const Constraint> constraints, const StepContext& ctx,
+               ResolverCounters& counters) noexcept override;
+
+  /// The settings read from the options.
+  const MirtichSettings& settings() const { return settings_; }
+
+ private:
+  MirtichSettings settings_;
+};
+
+}  // namespace impetus

@@ -1,0 +1,196 @@
+// Every shape pair through the `fcl` detector, in both argument orders: the normal points out of a into
+// b ((x_b − x_a)·n > 0, and equals the known direction), and the depth equals a known overlap.
+#include "detection_test_support.hpp"
+
+#include "fcl/analytic.hpp"
+
+#include <functional>
+#include <numbers>
+#include <random>
+
+namespace impetus::test {
+namespace {
+
+constexpr double kOverlap = 0.01;  // m, every stacked pair below overlaps by this along z
+constexpr double kDepthTol = 1e-6; // m: closed forms and face normals are exact; EPA is within 1e-6·size
+
+/// A named shape and the distance from its center to its top (= to its bottom: all are symmetric).
+struct Kind {
+  const char* name;
+  std::function<Shape()> make;
+  double half_height;
+};
+
+std::vector<Kind> kinds() {
+  return {
+      {"sphere", [] { return Shape(Sphere{0.5}); }, 0.5},
+      {"box", [] { return Shape(Box{Vec3(1.0, 0.8, 1.0)}); }, 0.5},
+      {"capsule", [] { return Shape(Capsule{0.3, 0.6}); }, 0.6},
+      {"cylinder", [] { return Shape(Cylinder{0.4, 1.0}); }, 0.5},
+      {"convex", [] { return Shape(mesh_shape(cube_mesh(0.5), MeshCollision::convex)); }, 0.5},
+      {"triangles", [] { return Shape(mesh_shape(cube_mesh(0.5), MeshCollision::triangles)); }, 0.5},
+  };
+}
+
+/// Checks the contacts of a pair whose known overlap is kOverlap along +z from `lower` to `upper`.
+void check_stacked(const std::vector<Contact>& contacts, const std::vector<RigidBody>& bodies, BodyIndex lower,
+                   const std::string& label, double depth_tol) {
+  ASSERT_FALSE(contacts.empty()) << label;
+  for (const Contact& c : contacts) {
+    ASSERT_EQ(c.a, 0u) << label;
+    ASSERT_EQ(c.b, 1u) << label;
+    const Vec3 expected = lower == c.a ? Vec3::UnitZ() : Vec3(-Vec3::UnitZ());
+    EXPECT_GT((bodies[c.b].position - bodies[c.a].position).dot(c.normal), 0.0) << label;
+    EXPECT_LT((c.normal - expected).norm(), 1e-6) << label << " normal " << c.normal.transpose();
+    EXPECT_NEAR(c.depth, kOverlap, depth_tol) << label;
+    EXPECT_NEAR(std::abs(c.normal.norm() - 1.0), 0.0, 1e-12) << label;
+  }
+}
+
+TEST(FclPairs, EveryBoundedPairInBothOrdersHasTheRightNormalAndDepth) {
+  for (const Kind& lo : kinds()) {
+    for (const Kind& hi : kinds()) {
+      const RigidBody lower = make_body("lower", lo.make(), Vec3::Zero());
+      const RigidBody upper =
+          make_body("upper", hi.make(), Vec3(0.0, 0.0, lo.half_height + hi.half_height - kOverlap));
+      const double tol = kDepthTol;
+      const std::string label = std::string(lo.name) + " under " + hi.name;
+      {
+        const std::vector<RigidBody> bodies{lower, upper};
+        check_stacked(detect_once(bodies), bodies, 0, label + " (lower is a)", tol);
+      }
+      {
+        const std::vector<RigidBody> bodies{upper, lower};
+        check_stacked(detect_once(bodies), bodies, 1, label + " (lower is b)", tol);
+      }
+    }
+  }
+}
+
+TEST(FclPairs, EveryShapeOnAPlaneInBothOrders) {
+  for (const Kind& k : kinds()) {
+    const RigidBody body = make_body("body", k.make(), Vec3(0.1, -0.2, k.half_height - kOverlap));
+    for (bool plane_first : {true, false}) {
+      const std::vector<RigidBody> bodies = plane_first ? std::vector{ground(), body} : std::vector{body, ground()};
+      check_stacked(detect_once(bodies), bodies, plane_first ? 0 : 1,
+                    std::string(k.name) + (plane_first ? " on plane (plane is a)" : " on plane (plane is b)"), 1e-12);
+    }
+  }
+}
+
+TEST(FclPairs, SphereSphereIsExact) {
+  // Centers 0.9 apart along (1, 2, 2)/3, radii 0.5 and 0.45: depth 0.05, point midway between surfaces.
+  const Vec3 u = Vec3(1, 2, 2) / 3.0;
+  const std::vector<RigidBody> bodies{make_body("a", Sphere{0.5}, Vec3(1, 1, 1)),
+                                      make_body("b", Sphere{0.45}, Vec3(1, 1, 1) + 0.9 * u)};
+  const auto contacts = detect_once(bodies);
+  ASSERT_EQ(contacts.size(), 1u);
+  EXPECT_LT((contacts[0].normal - u).norm(), 1e-15);
+  EXPECT_NEAR(contacts[0].depth, 0.05, 1e-15);
+  const Vec3 mid = 0.5 * ((Vec3(1, 1, 1) + 0.5 * u) + (bodies[1].position - 0.45 * u));
+  EXPECT_LT((contacts[0].point - mid).norm(), 1e-15);
+}
+
+TEST(FclPairs, SphereOnAPlaneTouchesAtItsLowestPoint) {
+  const std::vector<RigidBody> bodies{ground(), make_body("ball", Sphere{0.5}, Vec3(2, 3, 0.49))};
+  const auto contacts = detect_once(bodies);
+  ASSERT_EQ(contacts.size(), 1u);
+  EXPECT_LT((contacts[0].point - Vec3(2, 3, -0.005)).norm(), 1e-15);
+  EXPECT_NEAR(contacts[0].depth, 0.01, 1e-15);
+}
+
+TEST(FclPairs, SphereAgainstABoxEdgeAndCorner) {
+  // Sphere r = 0.5 near the box's (+x, +z) edge, center at distance 0.49 from it along (1, 0, 1)/√2.
+  const Vec3 u = Vec3(1, 0, 1).normalized();
+  const Vec3 edge(0.5, 0.1, 0.5);
+  for (bool sphere_first : {false, true}) {
+    const RigidBody box = make_body("box", Box{Vec3(1, 1, 1)}, Vec3::Zero());
+    const RigidBody ball = make_body("ball", Sphere{0.5}, edge + 0.49 * u);
+    const std::vector<RigidBody> bodies = sphere_first ? std::vector{ball, box} : std::vector{box, ball};
+    const auto contacts = detect_once(bodies);
+    ASSERT_EQ(contacts.size(), 1u);
+    EXPECT_LT((contacts[0].normal - (sphere_first ? -u : u)).norm(), 1e-12);
+    EXPECT_NEAR(contacts[0].depth, 0.01, 1e-12);
+    EXPECT_LT((contacts[0].point - (edge + 0.5 * (0.49 - 0.5) * u)).norm(), 1e-12);
+  }
+}
+
+TEST(FclPairs, CylinderAgainstCylinderSideBySideGivesTheirCommonLine) {
+  // Two lying cylinders (axes along x), radius 0.5, centers 0.99 apart in y: depth 0.01, 2 points.
+  const Mat3 lying = rotation_about(Vec3::UnitY(), std::numbers::pi / 2);
+  const std::vector<RigidBody> bodies{make_body("a", Cylinder{0.5, 2.0}, Vec3::Zero(), lying),
+                                      make_body("b", Cylinder{0.5, 2.0}, Vec3(0.5, 0.99, 0), lying)};
+  const auto contacts = detect_once(bodies);
+  ASSERT_EQ(contacts.size(), 2u);
+  for (const Contact& c : contacts) {
+    EXPECT_LT((c.normal - Vec3::UnitY()).norm(), 1e-12);  // the radial candidate axis is exact
+    EXPECT_NEAR(c.depth, 0.01, 1e-12);
+  }
+  EXPECT_NEAR(std::abs(contacts[0].point.x() - contacts[1].point.x()), 1.5, 1e-6);  // overlap x ∈ [−0.5, 1]
+}
+
+TEST(FclPairs, TriangleMeshOnTriangleMeshFindsTheContactWithOutwardNormals) {
+  const std::vector<RigidBody> bodies{
+      make_body("a", mesh_shape(cube_mesh(0.5), MeshCollision::triangles), Vec3::Zero()),
+      make_body("b", mesh_shape(cube_mesh(0.5), MeshCollision::triangles), Vec3(0.2, 0.1, 0.99))};
+  const auto contacts = detect_once(bodies);
+  ASSERT_FALSE(contacts.empty());
+  EXPECT_LE(contacts.size(), 4u);
+  for (const Contact& c : contacts) EXPECT_GT(c.normal.z(), 0.5) << c.normal.transpose();  // out of a into b
+}
+
+}  // namespace
+}  // namespace impetus::test
+
+namespace impetus::test {
+namespace {
+
+TEST(FclPairs, RandomPairsHaveFiniteOutwardNormalsAndConsistentDepths) {
+  // Random poses of every pair near contact. For every contact: a finite unit normal; the
+  // orientation out of a (the overlap along n is smaller than along −n: the explicit check); and a
+  // depth within the margin that never exceeds the overlap of the shapes along n.
+  std::mt19937 rng(12345);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  const auto random_rotation = [&] { return Mat3(Quat(u(rng), u(rng), u(rng), u(rng)).normalized()); };
+  const FclDetectorSettings settings;
+  std::size_t checked = 0;
+  for (const Kind& ka : kinds()) {
+    for (const Kind& kb : kinds()) {
+      // (The triangle mesh here is a cube, so the convex checks apply to it too.)
+      for (int trial = 0; trial < 40; ++trial) {
+        const Vec3 dir = Vec3(u(rng), u(rng), u(rng)).normalized();
+        const double distance = (ka.half_height + kb.half_height) * (0.75 + 0.3 * (u(rng) + 1.0) / 2.0);
+        std::vector<RigidBody> bodies{make_body("a", ka.make(), Vec3::Zero(), random_rotation()),
+                                      make_body("b", kb.make(), distance * dir, random_rotation())};
+        FclDetector detector(settings);
+        ASSERT_TRUE(detector.set_bodies(bodies, {}).ok);
+        std::vector<Contact> contacts;
+        DetectorCounters counters;
+        detector.detect(bodies, StepContext{}, contacts, counters);
+        EXPECT_EQ(detector.last_profile().fcl_failures, 0u);
+        std::vector<collision::ShapeGeometry> g;
+        for (const RigidBody& b : bodies) {
+          std::shared_ptr<collision::MeshData> mesh;
+          if (const auto* m = std::get_if<MeshShape>(&b.shape)) mesh = collision::make_mesh_data(*m->mesh, true);
+          g.push_back(collision::make_geometry(b.shape, mesh));
+        }
+        const collision::Placed pa{&g[0], bodies[0].position, bodies[0].rotation};
+        const collision::Placed pb{&g[1], bodies[1].position, bodies[1].rotation};
+        for (const Contact& c : contacts) {
+          const std::string label = std::string(ka.name) + "-" + kb.name + " trial " + std::to_string(trial);
+          ASSERT_TRUE(c.normal.allFinite() && c.point.allFinite() && std::isfinite(c.depth)) << label;
+          EXPECT_NEAR(c.normal.norm(), 1.0, 1e-12) << label;
+          const double along = collision::overlap_along(pa, pb, c.normal);
+          EXPECT_LT(along, collision::overlap_along(pa, pb, -c.normal)) << label;
+          EXPECT_GE(c.depth, -settings.margin - 1e-12) << label;
+          EXPECT_LE(c.depth, along + 1e-6) << label;
+          ++checked;
+        }
+      }
+    }
+  }
+  EXPECT_GT(checked, 500u);
+}
+
+}  // namespace
+}  // namespace impetus::test

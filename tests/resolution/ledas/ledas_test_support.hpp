@@ -1,0 +1,152 @@
+#pragma once
+// Hand-built bodies, contacts and tiny analytic detectors for the LEDAS resolver tests (no FCL).
+#include "impetus/core/mass.hpp"
+#include "impetus/modules/contact.hpp"
+#include "impetus/modules/detector.hpp"
+#include "ledas/ledas.hpp"
+
+#include <cmath>
+#include <span>
+#include <vector>
+
+namespace impetus::ledas_test {
+
+inline RigidBody solid(const Shape& shape, double mass, const Vec3& position, const Vec3& velocity = Vec3::Zero(),
+                       double restitution = 0.0, const Mat3& rotation = Mat3::Identity()) {
+  RigidBody b;
+  b.shape = shape;
+  const auto unit = primitive_mass_properties(shape);
+  b.mass = mass;
+  b.inv_mass = 1.0 / mass;
+  b.inertia_body = mass / unit->volume * unit->inertia_per_density;
+  b.inv_inertia_body = b.inertia_body.inverse();
+  b.position = position;
+  b.rotation = rotation;
+  b.velocity = velocity;
+  b.material.restitution = restitution;
+  return b;
+}
+
+inline RigidBody sphere(double radius, double mass, const Vec3& position, const Vec3& velocity = Vec3::Zero(),
+                        double restitution = 0.0) {
+  return solid(Sphere{radius}, mass, position, velocity, restitution);
+}
+
+inline RigidBody ground_plane(double restitution = 0.0) {
+  RigidBody g;
+  g.name = "ground";
+  g.shape = Plane{};
+  make_fixed(g);
+  g.material.restitution = restitution;
+  return g;
+}
+
+inline Contact contact(BodyIndex a, BodyIndex b, const Vec3& point, const Vec3& normal, double depth = 0.0) {
+  Contact c;
+  c.a = a;
+  c.b = b;
+  c.point = point;
+  c.normal = normal.normalized();
+  c.depth = depth;
+  return c;
+}
+
+/// One resolution with `resolver`; returns the counters.
+inline ResolverCounters resolve(LedasResolver& resolver, std::vector<RigidBody>& bodies, std::vector<Contact>& contacts,
+                                std::span<const Constraint> constraints = {}, double dt = 1e-3) {
+  ResolverCounters counters;
+  StepContext ctx;
+  ctx.dt = dt;
+  resolver.resolve(bodies, contacts, constraints, ctx, counters);
+  return counters;
+}
+
+inline LedasSettings settings_for(LedasMode mode) {
+  LedasSettings s;
+  s.mode = mode;
+  return s;
+}
+
+inline Vec3 momentum(std::span<const RigidBody> bodies) {
+  Vec3 p = Vec3::Zero();
+  for (const RigidBody& b : bodies)
+    if (!b.fixed) p += b.mass * b.velocity;
+  return p;
+}
+
+inline Vec3 angular_momentum(std::span<const RigidBody> bodies) {
+  Vec3 l = Vec3::Zero();
+  for (const RigidBody& b : bodies)
+    if (!b.fixed) l += b.position.cross(b.mass * b.velocity) + b.inertia_world() * b.angular_velocity;
+  return l;
+}
+
+inline double kinetic_energy(std::span<const RigidBody> bodies) {
+  double e = 0.0;
+  for (const RigidBody& b : bodies)
+    if (!b.fixed)
+      e += 0.5 * b.mass * b.velocity.squaredNorm() + 0.5 * b.angular_velocity.dot(b.inertia_world() * b.angular_velocity);
+  return e;
+}
+
+/// Sphere–sphere contacts (centres closer than 2r(1 + 1e-6)) and sphere–plane contacts for every plane
+/// body (the solid half-space n·x ≤ offset), following the Contact convention (a < b, n out of a).
+inline std::vector<Contact> sphere_contacts(std::span<const RigidBody> bodies) {
+  std::vector<Contact> out;
+  for (BodyIndex i = 0; i < bodies.size(); ++i) {
+    for (BodyIndex j = i + 1; j < bodies.size(); ++j) {
+      const auto* si = std::get_if<Sphere>(&bodies[i].shape);
+      const auto* sj = std::get_if<Sphere>(&bodies[j].shape);
+      const auto* pj = std::get_if<Plane>(&bodies[j].shape);
+      if (si && sj) {
+        const Vec3 d = bodies[j].position - bodies[i].position;
+        const double reach = si->radius + sj->radius;
+        if (d.norm() < reach * (1.0 + 1e-6))
+          out.push_back(contact(i, j, bodies[i].position + d.normalized() * (si->radius - 0.5 * (reach - d.norm())),
+                                d.normalized(), reach - d.norm()));
+      } else if (si && pj) {  // plane normal points out of the plane's solid, into the sphere: n_contact = −normal
+        const double height = pj->normal.dot(bodies[i].position) - pj->offset;
+        if (height < si->radius * (1.0 + 1e-6))
+          out.push_back(contact(i, j, bodies[i].position - si->radius * pj->normal, -pj->normal, si->radius - height));
+      }
+    }
+  }
+  return out;
+}
+
+/// Contacts of boxes on a ground plane z = 0 (body 0) and of box j on box j − 1 (a stack, nearly
+/// axis-aligned): each corner of the upper box within `margin` of the lower face and above it.
+class BoxStackDetector final : public CollisionDetector {
+ public:
+  explicit BoxStackDetector(double margin) : margin_(margin) {}
+  ModuleStatus set_bodies(std::span<const RigidBody>, std::span<const BodyPair>) noexcept override { return {}; }
+  void detect(std::span<const RigidBody> bodies, const StepContext&, std::vector<Contact>& contacts,
+              DetectorCounters& counters) noexcept override {
+    for (BodyIndex j = 1; j < bodies.size(); ++j) {
+      const RigidBody& upper = bodies[j];
+      const Vec3 half_u = 0.5 * std::get<Box>(upper.shape).size;
+      const RigidBody& lower = bodies[j - 1];
+      for (int corner = 0; corner < 8; ++corner) {
+        const Vec3 local((corner & 1 ? 1 : -1) * half_u.x(), (corner & 2 ? 1 : -1) * half_u.y(),
+                         (corner & 4 ? 1 : -1) * half_u.z());
+        const Vec3 p = upper.position + upper.rotation * local;
+        if (j == 1) {  // on the ground
+          if (p.z() < margin_) contacts.push_back(contact(0, j, p, Vec3::UnitZ(), -p.z()));
+          continue;
+        }
+        const Vec3 half_l = 0.5 * std::get<Box>(lower.shape).size;
+        const Vec3 in_lower = lower.rotation.transpose() * (p - lower.position);
+        const double height = in_lower.z() - half_l.z();
+        if (height < margin_ && height > -half_l.z() && std::abs(in_lower.x()) <= half_l.x() + 1e-9 &&
+            std::abs(in_lower.y()) <= half_l.y() + 1e-9)
+          contacts.push_back(contact(j - 1, j, p, lower.rotation.col(2), -height));
+      }
+    }
+    counters.contacts += contacts.size();
+  }
+
+ private:
+  double margin_;
+};
+
+}  // namespace impetus::ledas_test

@@ -1,0 +1,200 @@
+// LEDAS resolver on the paper's benchmark scenes (pyramid drop, line push) and singular systems
+// (Figure 2, a box on five points); the dense and sparse paths agree.
+#include "impetus/core/generators.hpp"
+#include "ledas_test_support.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cstdio>
+
+namespace impetus {
+namespace {
+
+using namespace ledas_test;
+
+struct Outcome {
+  std::vector<RigidBody> bodies;
+  std::vector<Contact> contacts;
+  ResolverCounters counters;
+  LedasStats stats;
+};
+
+Outcome run(std::vector<RigidBody> bodies, const LedasSettings& settings) {
+  Outcome out{std::move(bodies), {}, {}, {}};
+  out.contacts = sphere_contacts(out.bodies);
+  LedasResolver resolver(settings);
+  out.counters = resolve(resolver, out.bodies, out.contacts);
+  out.stats = resolver.last_stats();
+  return out;
+}
+
+double normal_velocity_of(const Outcome& o, const Contact& c) { return normal_velocity(c, o.bodies[c.a], o.bodies[c.b]); }
+
+// Pyramid drop (every sphere at (0, 0, −1), e = 0). Complementary: p ≥ 0, v_n⁺ ≥ −1e-9, |p v_n⁺| ≤ 1e-9,
+// mirror-symmetric in x (1e-9). Paper: ends with no approaching contact; rounds and pulling impulses
+// printed.
+TEST(LedasSystems, PyramidDrop) {
+  for (int rows : {3, 4, 10, 20}) {
+    PyramidParams params;
+    params.rows = rows;
+    const std::vector<RigidBody> pyramid = make_pyramid(params);
+    const std::size_t spheres = pyramid.size() - 1;
+    const Outcome exact = run(pyramid, settings_for(LedasMode::complementary));
+    ASSERT_EQ(exact.contacts.size(), static_cast<std::size_t>(3 * rows * (rows - 1) / 2 + rows));
+    for (const Contact& c : exact.contacts) {
+      const double vn = normal_velocity_of(exact, c);
+      EXPECT_GE(c.impulse, 0.0);
+      EXPECT_GE(vn, -1e-9);
+      EXPECT_LE(std::abs(c.impulse * vn), 1e-9);
+    }
+    // Mirror in x: sphere i of row j ↔ sphere (rows − j − 1 − i) of the same row.
+    std::size_t first = 0;
+    for (int j = 0; j < rows; ++j) {
+      const int n = rows - j;
+      for (int i = 0; i < n; ++i) {
+        const Vec3& v = exact.bodies[first + static_cast<std::size_t>(i)].velocity;
+        const Vec3& w = exact.bodies[first + static_cast<std::size_t>(n - 1 - i)].velocity;
+        EXPECT_NEAR(v.x(), -w.x(), 1e-9);
+        EXPECT_NEAR(v.z(), w.z(), 1e-9);
+      }
+      first += static_cast<std::size_t>(n);
+    }
+    EXPECT_EQ(exact.counters.non_converged, 0u);
+    EXPECT_LE(exact.counters.complementarity_error, 1e-9);
+
+    const Outcome paper = run(pyramid, settings_for(LedasMode::paper));
+    for (const Contact& c : paper.contacts) EXPECT_GE(normal_velocity_of(paper, c), -1e-9);
+    EXPECT_EQ(paper.counters.non_converged, 0u);
+    EXPECT_LE(paper.counters.residual, 1e-9);
+    std::printf("[ledas] pyramid K=%d (%zu spheres, %zu contacts): complementary %llu active-set iterations, "
+                "%llu released (pulling), %llu singular, KE after %.6g J | paper %llu rounds, %llu pulling "
+                "impulses applied, %llu singular, complementarity error %.3g, KE after %.6g J\n",
+                rows, spheres, exact.contacts.size(), (unsigned long long)exact.counters.rounds,
+                (unsigned long long)exact.counters.pulling_impulses, (unsigned long long)exact.counters.singular_systems,
+                kinetic_energy(exact.bodies), (unsigned long long)paper.counters.rounds,
+                (unsigned long long)paper.counters.pulling_impulses, (unsigned long long)paper.counters.singular_systems,
+                paper.counters.complementarity_error, kinetic_energy(paper.bodies));
+  }
+}
+
+// Line push (first sphere at (1, 0, 0), fixed wall after the last). e = 1: both modes send the first
+// sphere back at −1 and leave the rest at rest; e = 0: everything stops. Exact (1e-12) in complementary
+// mode; the paper's rounds stop when no contact approaches faster than the tolerance (1e-9 m/s), so
+// the spheres may keep N × 1e-9 m/s. Rounds printed.
+TEST(LedasSystems, LinePush) {
+  for (int count : {10, 100})
+    for (double e : {0.0, 1.0})
+      for (LedasMode mode : {LedasMode::paper, LedasMode::complementary}) {
+        LineParams params;
+        params.count = count;
+        params.restitution = e;
+        const Outcome o = run(make_line(params), settings_for(mode));
+        ASSERT_EQ(o.contacts.size(), static_cast<std::size_t>(count));
+        for (int i = 0; i < count; ++i) {
+          const double expected = (e == 1.0 && i == 0) ? -1.0 : 0.0;
+          const double tolerance = mode == LedasMode::paper ? count * 1e-9 : 1e-12;
+          EXPECT_NEAR(o.bodies[static_cast<std::size_t>(i)].velocity.x(), expected, tolerance) << "sphere " << i;
+        }
+        for (const Contact& c : o.contacts) EXPECT_GE(normal_velocity_of(o, c), -1e-9);
+        EXPECT_EQ(o.counters.non_converged, 0u);
+        std::printf("[ledas] line N=%d e=%g %s: %llu rounds (systems solved), %llu pulling, residual %.2g\n", count, e,
+                    mode == LedasMode::paper ? "paper" : "complementary", (unsigned long long)o.counters.rounds,
+                    (unsigned long long)o.counters.pulling_impulses, o.counters.residual);
+      }
+}
+
+// A stack of ten boxes (four corner contacts per interface) all falling at 1 m/s onto the ground, e = 0.
+// The bodies move together, so in the paper's mode only the ground contacts approach at first and the
+// stop travels up layer by layer; the complementary mode stops the whole stack at once. Both end with
+// no approaching contact (1e-9) and everything at rest (complementary 1e-12). Rounds printed.
+TEST(LedasSystems, BoxStackDrop) {
+  for (LedasMode mode : {LedasMode::paper, LedasMode::complementary}) {
+    std::vector<RigidBody> bodies{ground_plane()};
+    for (int i = 0; i < 10; ++i) bodies.push_back(solid(Box{Vec3(1, 1, 1)}, 1.0 + 0.1 * i, Vec3(0, 0, 0.5 + i), Vec3(0, 0, -1)));
+    std::vector<Contact> contacts;
+    DetectorCounters detected;
+    BoxStackDetector(1e-6).detect(bodies, StepContext{}, contacts, detected);
+    ASSERT_EQ(contacts.size(), 40u);
+    LedasResolver resolver(settings_for(mode));
+    const ResolverCounters c = resolve(resolver, bodies, contacts);
+    for (const Contact& k : contacts) EXPECT_GE(normal_velocity(k, bodies[k.a], bodies[k.b]), -1e-9);
+    for (std::size_t i = 1; i < bodies.size(); ++i)
+      EXPECT_LT(bodies[i].velocity.norm() + bodies[i].angular_velocity.norm(), mode == LedasMode::paper ? 1e-7 : 1e-12);
+    EXPECT_EQ(c.non_converged, 0u);
+    std::printf("[ledas] 10-box stack drop (40 contacts) %s: %llu rounds (systems solved), %llu pulling, %llu singular\n",
+                mode == LedasMode::paper ? "paper" : "complementary", (unsigned long long)c.rounds,
+                (unsigned long long)c.pulling_impulses, (unsigned long long)c.singular_systems);
+  }
+}
+
+// The paper's Figure 2: a segment on a longer segment with contacts at its two ends and its middle.
+// A is singular (three collinear points, two relative degrees of freedom); the minimum-norm solution
+// shares the impulse equally (1e-9). Both bodies move, gravity-free.
+TEST(LedasSystems, FigureTwoSharesTheImpulseEqually) {
+  for (LedasMode mode : {LedasMode::paper, LedasMode::complementary}) {
+    std::vector<RigidBody> bodies{solid(Box{Vec3(4, 0.2, 0.2)}, 3.0, {0, 0, 0}),
+                                  solid(Box{Vec3(2, 0.2, 0.2)}, 1.0, {0, 0, 0.2}, {0.1, 0, -1})};
+    std::vector<Contact> contacts;
+    for (double x : {-1.0, 0.0, 1.0}) contacts.push_back(contact(0, 1, {x, 0, 0.1}, Vec3::UnitZ()));
+    LedasResolver resolver(settings_for(mode));
+    const ResolverCounters c = resolve(resolver, bodies, contacts);
+    const double total = 1.0 * 3.0 / 4.0;  // reduced mass × approach speed
+    for (const Contact& k : contacts) EXPECT_NEAR(k.impulse, total / 3.0, 1e-9);
+    EXPECT_GE(c.singular_systems, 1u);
+    EXPECT_EQ(c.nan_caught, 0u);
+    EXPECT_NEAR(bodies[0].velocity.z(), bodies[1].velocity.z(), 1e-12);
+    EXPECT_LT(bodies[1].angular_velocity.norm() + bodies[0].angular_velocity.norm(), 1e-12);
+  }
+}
+
+// A box landing flat on four corner contacts plus a fifth at the face centre: rank 3 of 5; minimum
+// norm gives m v / 5 at each point (1e-9), no NaN.
+TEST(LedasSystems, BoxOnFivePointsSharesEqually) {
+  for (LedasMode mode : {LedasMode::paper, LedasMode::complementary}) {
+    std::vector<RigidBody> bodies{ground_plane(), solid(Box{Vec3(1, 0.8, 0.5)}, 2.0, {0, 0, 0.25}, {0, 0, -1.5})};
+    std::vector<Contact> contacts;
+    for (int k = 0; k < 4; ++k) contacts.push_back(contact(0, 1, {k & 1 ? 0.5 : -0.5, k & 2 ? 0.4 : -0.4, 0}, Vec3::UnitZ()));
+    contacts.push_back(contact(0, 1, {0, 0, 0}, Vec3::UnitZ()));
+    LedasResolver resolver(settings_for(mode));
+    const ResolverCounters c = resolve(resolver, bodies, contacts);
+    for (const Contact& k : contacts) EXPECT_NEAR(k.impulse, 2.0 * 1.5 / 5.0, 1e-9);
+    EXPECT_LT(bodies[1].velocity.norm() + bodies[1].angular_velocity.norm(), 1e-12);
+    EXPECT_GE(c.singular_systems, 1u);
+    EXPECT_EQ(c.nan_caught, 0u);
+  }
+}
+
+// Pyramid K = 20: the sparse path (islands above dense_limit; updates, sparse minimum norm) and the
+// dense path give the same impulses and velocities (1e-9); resolving the same contact graph again
+// reuses every symbolic analysis.
+TEST(LedasSystems, SparseAndDensePathsAgree) {
+  PyramidParams params;
+  params.rows = 20;
+  const std::vector<RigidBody> pyramid = make_pyramid(params);
+  LedasSettings sparse = settings_for(LedasMode::complementary), dense = sparse;
+  sparse.solver.dense_limit = 8;
+  dense.solver.dense_limit = 100000;
+  const Outcome a = run(pyramid, sparse), b = run(pyramid, dense);
+  EXPECT_GT(a.stats.velocity.sparse, 0u);
+  EXPECT_EQ(b.stats.velocity.sparse, 0u);
+  ASSERT_EQ(a.contacts.size(), b.contacts.size());
+  for (std::size_t k = 0; k < a.contacts.size(); ++k) EXPECT_NEAR(a.contacts[k].impulse, b.contacts[k].impulse, 1e-9);
+  for (std::size_t i = 0; i < a.bodies.size(); ++i) EXPECT_LT((a.bodies[i].velocity - b.bodies[i].velocity).norm(), 1e-9);
+  // The same contact graph again: the sparse symbolic analyses are reused, none is recomputed.
+  LedasResolver again(sparse);
+  std::vector<RigidBody> bodies = pyramid;
+  std::vector<Contact> contacts = sphere_contacts(bodies);
+  resolve(again, bodies, contacts);
+  bodies = pyramid;
+  resolve(again, bodies, contacts);
+  EXPECT_GT(again.last_stats().velocity.symbolic_reused, 0u);
+  EXPECT_EQ(again.last_stats().velocity.symbolic_analyses, 0u);
+  std::printf("[ledas] pyramid K=20 sparse path: %llu sparse factorizations, %llu updates, %llu symbolic analyses, "
+              "%llu singular | dense path: %llu dense factorizations, %llu singular\n",
+              (unsigned long long)a.stats.velocity.sparse, (unsigned long long)a.stats.velocity.updated,
+              (unsigned long long)a.stats.velocity.symbolic_analyses, (unsigned long long)a.stats.velocity.singular,
+              (unsigned long long)b.stats.velocity.dense, (unsigned long long)b.stats.velocity.singular);
+}
+
+}  // namespace
+}  // namespace impetus
