@@ -53,6 +53,7 @@ void RunStats::add_step(const World& world, const StepStatus& status) {
   non_converged_ += status.resolver.non_converged;
   singular_ += status.resolver.singular_systems;
   pulling_ += status.resolver.pulling_impulses;
+  energy_gains_ += status.resolver.energy_gain_events;
   max_residual_ = std::max(max_residual_, status.resolver.residual);
   for (const Contact& c : world.contacts()) max_penetration_ = std::max(max_penetration_, c.depth);
 }
@@ -79,6 +80,7 @@ json RunStats::summary(const World& world, double wall_seconds) const {
         {"non_converged", non_converged_},
         {"singular_systems", singular_},
         {"pulling_impulses", pulling_},
+        {"energy_gain_events", energy_gains_},
         {"max_residual_m_per_s", max_residual_}}},
       {"energy",
        {{"initial_j", e0}, {"final_j", e1}, {"drift_j", e1 - e0},
@@ -106,7 +108,8 @@ void print_summary(const json& s, std::ostream& out) {
       << s["contacts_per_step"]["max"].get<std::uint64_t>() << "\n"
       << "resolver              " << r["rounds"].get<std::uint64_t>() << " rounds (max "
       << r["max_rounds_per_step"].get<std::uint64_t>() << " per step), " << r["non_converged"].get<std::uint64_t>()
-      << " non-converged, " << r["singular_systems"].get<std::uint64_t>() << " singular, max residual "
+      << " non-converged, " << r["singular_systems"].get<std::uint64_t>() << " singular, "
+      << r["energy_gain_events"].get<std::uint64_t>() << " energy gains, max residual "
       << r["max_residual_m_per_s"].get<double>() << " m/s\n"
       << "energy                " << e["initial_j"].get<double>() << " J -> " << e["final_j"].get<double>()
       << " J (drift " << e["drift_j"].get<double>() << " J)\n"
@@ -164,6 +167,7 @@ json resolve_report(const World& world, const std::string& resolver, double seco
               {"residual", s.resolver.residual},
               {"pulling_impulses", s.resolver.pulling_impulses},
               {"singular_systems", s.resolver.singular_systems},
+              {"energy_gain_events", s.resolver.energy_gain_events},
               {"contacts", contacts},
               {"bodies", out_bodies}};
 }

@@ -35,7 +35,7 @@ class RunStats {
   Vec3 gravity_moment_ = Vec3::Zero();   // ∫ Σ x × m g dt: the angular momentum gravity adds about 0
   StepProfile time_;                     // summed over steps
   std::uint64_t steps_ = 0, contacts_ = 0, max_contacts_ = 0, rounds_ = 0, max_rounds_ = 0;
-  std::uint64_t non_converged_ = 0, singular_ = 0, pulling_ = 0;
+  std::uint64_t non_converged_ = 0, singular_ = 0, pulling_ = 0, energy_gains_ = 0;
   double max_penetration_ = 0.0, max_residual_ = 0.0;
 };
 

@@ -67,11 +67,17 @@ std::vector<ReadBody> read_generator(const SceneReader& r, const YAML::Node& nod
   return out;
 }
 
-Constraint read_constraint(const SceneReader& r, const YAML::Node& node, const std::vector<RigidBody>& bodies,
-                           const std::map<std::string, BodyIndex>& index_by_name) {
-  const Fields entry(r, node, "constraint", {"point_point"});
-  const Fields::Entry& kind = only_entry(r, entry, "point_point");
-  const Fields f(r, kind.value, "point_point", {"bodies", "point", "level", "collide"});
+namespace {
+
+// What every constraint kind has: two different bodies, not both fixed, a level, and `collide`.
+struct ConstraintEnds {
+  BodyIndex a = 0, b = 0;
+  ConstraintLevel level = ConstraintLevel::position;
+  bool collide = false;
+};
+
+ConstraintEnds read_ends(const SceneReader& r, const Fields& f, const std::vector<RigidBody>& bodies,
+                         const std::map<std::string, BodyIndex>& index_by_name) {
   const YAML::Node& names = f.require("bodies");
   if (!names.IsSequence() || names.size() != 2)
     r.fail(names, "'bodies' expects a list of two body names, got " + SceneReader::describe(names));
@@ -86,18 +92,61 @@ Constraint read_constraint(const SceneReader& r, const YAML::Node& node, const s
   const RigidBody& a = bodies[index[0]];
   const RigidBody& b = bodies[index[1]];
   if (a.fixed && b.fixed) r.fail(names, "both '" + a.name + "' and '" + b.name + "' are fixed; nothing can move");
-
-  PointPointConstraint c;
-  c.a = index[0];
-  c.b = index[1];
-  const Vec3 point = r.vec3(f.require("point"), "point");
-  // The joined point is given in the world at the initial poses; store it in each body's frame.
-  c.anchor_a = a.rotation.transpose() * (point - a.position);
-  c.anchor_b = b.rotation.transpose() * (point - b.position);
+  ConstraintEnds ends{index[0], index[1]};
   if (const YAML::Node* n = f.find("level"))
-    c.level = r.choice(*n, "level", {"velocity", "position"}) == "velocity" ? ConstraintLevel::velocity
-                                                                             : ConstraintLevel::position;
-  if (const YAML::Node* n = f.find("collide")) c.collide = r.boolean(*n, "collide");
+    ends.level = r.choice(*n, "level", {"velocity", "position"}) == "velocity" ? ConstraintLevel::velocity
+                                                                                : ConstraintLevel::position;
+  if (const YAML::Node* n = f.find("collide")) ends.collide = r.boolean(*n, "collide");
+  return ends;
+}
+
+// A world point at the initial poses, in a body's frame.
+Vec3 to_body(const RigidBody& body, const Vec3& world_point) {
+  return body.rotation.transpose() * (world_point - body.position);
+}
+
+}  // namespace
+
+Constraint read_constraint(const SceneReader& r, const YAML::Node& node, const std::vector<RigidBody>& bodies,
+                           const std::map<std::string, BodyIndex>& index_by_name) {
+  const Fields entry(r, node, "constraint", {"point_point", "coaxial"});
+  const Fields::Entry& kind = only_entry(r, entry, "point_point, coaxial");
+  if (kind.key == "point_point") {
+    const Fields f(r, kind.value, "point_point", {"bodies", "point", "level", "collide"});
+    const ConstraintEnds ends = read_ends(r, f, bodies, index_by_name);
+    const Vec3 point = r.vec3(f.require("point"), "point");
+    // The joined point is given in the world at the initial poses; store it in each body's frame.
+    PointPointConstraint c;
+    c.a = ends.a;
+    c.b = ends.b;
+    c.level = ends.level;
+    c.collide = ends.collide;
+    c.anchor_a = to_body(bodies[c.a], point);
+    c.anchor_b = to_body(bodies[c.b], point);
+    return c;
+  }
+  // coaxial: b's points `point` and `point + length·axis` stay on a's axis through `point` along `axis`
+  // (world values at the initial poses).
+  const Fields f(r, kind.value, "coaxial", {"bodies", "point", "axis", "length", "level", "collide"});
+  const ConstraintEnds ends = read_ends(r, f, bodies, index_by_name);
+  const Vec3 point = r.vec3(f.require("point"), "point");
+  const YAML::Node& axis_node = f.require("axis");
+  const Vec3 axis = r.vec3(axis_node, "axis");
+  if (!(axis.norm() > 1e-12)) r.fail(axis_node, "'axis' must be a non-zero vector");
+  CoaxialConstraint c;
+  c.a = ends.a;
+  c.b = ends.b;
+  c.level = ends.level;
+  c.collide = ends.collide;
+  if (const YAML::Node* n = f.find("length")) {
+    c.length = r.number(*n, "length");
+    if (!(c.length > 0.0)) r.fail(*n, "'length' must be positive, got " + std::to_string(c.length));
+  }
+  const Vec3 unit = axis.normalized();
+  c.anchor_a = to_body(bodies[c.a], point);
+  c.anchor_b = to_body(bodies[c.b], point);
+  c.axis_a = bodies[c.a].rotation.transpose() * unit;
+  c.axis_b = bodies[c.b].rotation.transpose() * unit;
   return c;
 }
 

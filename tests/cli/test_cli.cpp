@@ -153,7 +153,8 @@ TEST(Cli, TrajectoryCsvIsWellFormedAndBitIdenticalAcrossRuns) {
     ++rows;
     EXPECT_EQ(std::count(line.begin(), line.end(), ','), 15) << line;
   }
-  EXPECT_EQ(rows, 3 * 301);  // three bodies, initial state + 300 steps
+  const auto summary = nlohmann::json::parse(run("run --steps 1 --json").out);
+  EXPECT_EQ(rows, summary["bodies"].get<int>() * 301);  // every body, initial state + 300 steps
 }
 
 TEST(Cli, OutRefusesToOverwriteAnExistingFile) {

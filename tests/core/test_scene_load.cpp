@@ -229,6 +229,39 @@ constraints:
   EXPECT_LE((c.anchor_b - Vec3(1, 0, 0)).norm(), 1e-15);
 }
 
+// coaxial: the world point and axis at the initial poses map back from each body's frame (1e-14), the
+// axis is normalized, and a zero axis or a non-positive length is refused at its line and column.
+TEST(SceneLoad, CoaxialAxisAndPointMapBackToTheWorldInEachBody) {
+  const Scene scene = load(R"(bodies:
+  - {name: a, shape: {box: {size: [1, 1, 1]}}, mass: 1, position: [1, 2, 3], orientation: [0.3, 0.1, -0.7, 0.5]}
+  - {name: b, shape: {cylinder: {radius: 0.1, length: 1}}, mass: 1, position: [1, 2, 4], orientation: [1, 1, 0, 0]}
+constraints:
+  - coaxial: {bodies: [a, b], point: [1, 2, 3.5], axis: [0, 0, 2], length: 0.5, level: velocity}
+)");
+  ASSERT_EQ(scene.constraints.size(), 1u);
+  const auto& c = std::get<CoaxialConstraint>(scene.constraints[0]);
+  EXPECT_EQ(c.level, ConstraintLevel::velocity);
+  EXPECT_FALSE(c.collide);
+  EXPECT_DOUBLE_EQ(c.length, 0.5);
+  const RigidBody& a = scene.bodies[c.a];
+  const RigidBody& b = scene.bodies[c.b];
+  EXPECT_LE((a.position + a.rotation * c.anchor_a - Vec3(1, 2, 3.5)).norm(), 1e-14);
+  EXPECT_LE((b.position + b.rotation * c.anchor_b - Vec3(1, 2, 3.5)).norm(), 1e-14);
+  EXPECT_LE((a.rotation * c.axis_a - Vec3::UnitZ()).norm(), 1e-14);
+  EXPECT_LE((b.rotation * c.axis_b - Vec3::UnitZ()).norm(), 1e-14);
+
+  const std::string two_bodies = R"(bodies:
+  - {name: a, shape: {sphere: {radius: 1}}, mass: 1}
+  - {name: b, shape: {sphere: {radius: 1}}, mass: 1, position: [0, 0, 3]}
+constraints:
+)";
+  test::expect_error(two_bodies + "  - coaxial: {bodies: [a, b], point: [0, 0, 1], axis: [0, 0, 0]}\n", "scene.yaml:5:", "axis");
+  test::expect_error(two_bodies + "  - coaxial: {bodies: [a, b], point: [0, 0, 1], axis: [0, 0, 1], length: 0}\n",
+               "scene.yaml:5:", "length");
+  test::expect_error(two_bodies + "  - coaxial: {bodies: [a, b], point: [0, 0, 1], axis: [0, 0, 1], axle: 1}\n",
+               "scene.yaml:5:", "axle");
+}
+
 const std::filesystem::path kScenes = std::filesystem::path(IMPETUS_SOURCE_DIR) / "tests/core/scenes";
 
 TEST(SceneFile, GoodFileLoadsWithPathsRelativeToIt) {
