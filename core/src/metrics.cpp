@@ -5,9 +5,15 @@
 namespace impetus {
 
 WorldMetrics measure(const World& world) {
+  WorldMetrics m = measure_bodies(world.bodies(), world.settings().gravity);
+  for (const Contact& c : world.contacts()) m.max_penetration = std::max(m.max_penetration, c.depth);
+  m.contacts = world.contacts().size();
+  return m;
+}
+
+WorldMetrics measure_bodies(std::span<const RigidBody> bodies, const Vec3& g) {
   WorldMetrics m;
-  const Vec3 g = world.settings().gravity;
-  for (const RigidBody& b : world.bodies()) {
+  for (const RigidBody& b : bodies) {
     if (b.fixed) continue;
     const Vec3 spin = b.inertia_world() * b.angular_velocity;  // J_world ω
     m.kinetic_energy += 0.5 * b.mass * b.velocity.squaredNorm() + 0.5 * b.angular_velocity.dot(spin);
@@ -15,8 +21,6 @@ WorldMetrics measure(const World& world) {
     m.linear_momentum += b.mass * b.velocity;
     m.angular_momentum += b.position.cross(b.mass * b.velocity) + spin;
   }
-  for (const Contact& c : world.contacts()) m.max_penetration = std::max(m.max_penetration, c.depth);
-  m.contacts = world.contacts().size();
   return m;
 }
 

@@ -2,7 +2,11 @@
 
 #include "scene_body_setup.hpp"
 
+#include "impetus/core/error.hpp"
+
 #include <cassert>
+#include <cmath>
+#include <string>
 
 namespace impetus::scene_detail {
 
@@ -20,3 +24,18 @@ void set_mass_properties(RigidBody& body, const UnitMassProperties& unit, const 
 }
 
 }  // namespace impetus::scene_detail
+
+namespace impetus {
+
+void set_primitive_mass(RigidBody& body, double mass) {
+  const std::string label = "body '" + body.name + "'";
+  if (!(mass > 0.0) || !std::isfinite(mass))
+    throw Error(label + ": mass must be positive and finite, got " + std::to_string(mass));
+  const std::optional<UnitMassProperties> unit = primitive_mass_properties(body.shape);
+  if (!unit)
+    throw Error(label + ": a " + std::string(shape_kind_name(body.shape)) +
+                " has no closed-form mass properties (planes are fixed; meshes go through the asset pipeline)");
+  scene_detail::set_mass_properties(body, *unit, scene_detail::MassSpec{mass, std::nullopt, std::nullopt});
+}
+
+}  // namespace impetus

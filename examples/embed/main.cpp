@@ -24,12 +24,7 @@ int main(int argc, char** argv) {
     impetus::RigidBody ball;
     ball.name = "ball";
     ball.shape = impetus::Sphere{0.1};
-    const auto unit = impetus::primitive_mass_properties(ball.shape);
-    const double density = 2.0 / unit->volume;
-    ball.mass = 2.0;
-    ball.inv_mass = 0.5;
-    ball.inertia_body = density * unit->inertia_per_density;
-    ball.inv_inertia_body = ball.inertia_body.inverse();
+    impetus::set_primitive_mass(ball, 2.0);  // a uniform solid sphere of 2 kg
     ball.position = {0, 0, 100};
     world.add_body(ball);
 

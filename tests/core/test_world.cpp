@@ -22,11 +22,7 @@ RigidBody sphere(const std::string& name, double radius, double mass, const Vec3
   RigidBody b;
   b.name = name;
   b.shape = Sphere{radius};
-  const auto unit = primitive_mass_properties(b.shape);
-  b.mass = mass;
-  b.inv_mass = 1.0 / mass;
-  b.inertia_body = mass / unit->volume * unit->inertia_per_density;
-  b.inv_inertia_body = b.inertia_body.inverse();
+  set_primitive_mass(b, mass);
   b.position = position;
   return b;
 }

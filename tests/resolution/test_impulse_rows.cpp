@@ -14,11 +14,7 @@ namespace {
 RigidBody box_body(const Vec3& size, double mass, const Vec3& position, const Mat3& rotation) {
   RigidBody b;
   b.shape = Box{size};
-  const auto unit = primitive_mass_properties(b.shape);
-  b.mass = mass;
-  b.inv_mass = 1.0 / mass;
-  b.inertia_body = mass / unit->volume * unit->inertia_per_density;
-  b.inv_inertia_body = b.inertia_body.inverse();
+  set_primitive_mass(b, mass);
   b.position = position;
   b.rotation = rotation;
   return b;

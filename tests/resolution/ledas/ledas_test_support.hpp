@@ -1,6 +1,7 @@
 #pragma once
 // Hand-built bodies, contacts and tiny analytic detectors for the LEDAS resolver tests (no FCL).
 #include "impetus/core/mass.hpp"
+#include "impetus/core/metrics.hpp"
 #include "impetus/modules/contact.hpp"
 #include "impetus/modules/detector.hpp"
 #include "ledas/ledas.hpp"
@@ -15,11 +16,7 @@ inline RigidBody solid(const Shape& shape, double mass, const Vec3& position, co
                        double restitution = 0.0, const Mat3& rotation = Mat3::Identity()) {
   RigidBody b;
   b.shape = shape;
-  const auto unit = primitive_mass_properties(shape);
-  b.mass = mass;
-  b.inv_mass = 1.0 / mass;
-  b.inertia_body = mass / unit->volume * unit->inertia_per_density;
-  b.inv_inertia_body = b.inertia_body.inverse();
+  set_primitive_mass(b, mass);
   b.position = position;
   b.rotation = rotation;
   b.velocity = velocity;
@@ -67,27 +64,10 @@ inline LedasSettings settings_for(LedasMode mode) {
   return s;
 }
 
-inline Vec3 momentum(std::span<const RigidBody> bodies) {
-  Vec3 p = Vec3::Zero();
-  for (const RigidBody& b : bodies)
-    if (!b.fixed) p += b.mass * b.velocity;
-  return p;
-}
-
-inline Vec3 angular_momentum(std::span<const RigidBody> bodies) {
-  Vec3 l = Vec3::Zero();
-  for (const RigidBody& b : bodies)
-    if (!b.fixed) l += b.position.cross(b.mass * b.velocity) + b.inertia_world() * b.angular_velocity;
-  return l;
-}
-
-inline double kinetic_energy(std::span<const RigidBody> bodies) {
-  double e = 0.0;
-  for (const RigidBody& b : bodies)
-    if (!b.fixed)
-      e += 0.5 * b.mass * b.velocity.squaredNorm() + 0.5 * b.angular_velocity.dot(b.inertia_world() * b.angular_velocity);
-  return e;
-}
+// Momenta and kinetic energy of the movable bodies, as the core measures them.
+inline Vec3 momentum(std::span<const RigidBody> bodies) { return measure_bodies(bodies).linear_momentum; }
+inline Vec3 angular_momentum(std::span<const RigidBody> bodies) { return measure_bodies(bodies).angular_momentum; }
+inline double kinetic_energy(std::span<const RigidBody> bodies) { return measure_bodies(bodies).kinetic_energy; }
 
 /// Sphere–sphere contacts (centres closer than 2r(1 + 1e-6)) and sphere–plane contacts for every plane
 /// body (the solid half-space n·x ≤ offset), following the Contact convention (a < b, n out of a).

@@ -3,6 +3,7 @@
 // they assert (momentum, energy), computed here independently of the resolver's own algebra.
 #include "impetus/core/body.hpp"
 #include "impetus/core/mass.hpp"
+#include "impetus/core/metrics.hpp"
 #include "impetus/modules/contact.hpp"
 #include "mirtich/mirtich.hpp"
 
@@ -75,30 +76,10 @@ inline ResolverCounters resolve(std::vector<RigidBody>& bodies, std::vector<Cont
   return counters;
 }
 
-/// Σ m v over movable bodies (kg·m/s).
-inline Vec3 linear_momentum(std::span<const RigidBody> bodies) {
-  Vec3 p = Vec3::Zero();
-  for (const RigidBody& b : bodies)
-    if (!b.fixed) p += b.mass * b.velocity;
-  return p;
-}
-
-/// Σ (x × m v + J_world ω) about the world origin (kg·m²/s).
-inline Vec3 angular_momentum(std::span<const RigidBody> bodies) {
-  Vec3 l = Vec3::Zero();
-  for (const RigidBody& b : bodies)
-    if (!b.fixed) l += b.position.cross(b.mass * b.velocity) + b.inertia_world() * b.angular_velocity;
-  return l;
-}
-
-/// Σ ½ m v² + ½ ωᵀ J_world ω (J).
-inline double kinetic_energy(std::span<const RigidBody> bodies) {
-  double e = 0.0;
-  for (const RigidBody& b : bodies)
-    if (!b.fixed)
-      e += 0.5 * b.mass * b.velocity.squaredNorm() + 0.5 * b.angular_velocity.dot(b.inertia_world() * b.angular_velocity);
-  return e;
-}
+/// Momenta and kinetic energy of the movable bodies, as the core measures them.
+inline Vec3 linear_momentum(std::span<const RigidBody> bodies) { return measure_bodies(bodies).linear_momentum; }
+inline Vec3 angular_momentum(std::span<const RigidBody> bodies) { return measure_bodies(bodies).angular_momentum; }
+inline double kinetic_energy(std::span<const RigidBody> bodies) { return measure_bodies(bodies).kinetic_energy; }
 
 /// A row of `count` touching spheres (radius r, mass 1) on the x axis, ball 0 moving at +x `speed`,
 /// with contacts (i, i+1) along +x: Newton's cradle without strings.

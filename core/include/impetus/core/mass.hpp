@@ -19,4 +19,11 @@ struct UnitMassProperties {
 /// a mesh (computed by the asset pipeline).
 std::optional<UnitMassProperties> primitive_mass_properties(const Shape& shape);
 
+struct RigidBody;
+
+/// Gives a movable `body` with a primitive shape the mass `mass` (kg, > 0) and the inertia of a uniform
+/// solid of that shape (and both inverses). Throws Error for a plane, a mesh (use the asset pipeline)
+/// or a non-positive mass. For embedding code; scene files do the same through `mass:`/`density:`.
+void set_primitive_mass(RigidBody& body, double mass);
+
 }  // namespace impetus

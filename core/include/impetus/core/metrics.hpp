@@ -4,6 +4,8 @@
 
 #include "impetus/core/world.hpp"
 
+#include <span>
+
 namespace impetus {
 
 struct WorldMetrics {
@@ -17,6 +19,10 @@ struct WorldMetrics {
 
 /// Measures `world` now.
 WorldMetrics measure(const World& world);
+
+/// Measures a set of bodies (fixed ones left out), with potential energy in `gravity` (m/s²). The
+/// contact fields stay zero.
+WorldMetrics measure_bodies(std::span<const RigidBody> bodies, const Vec3& gravity = Vec3(0.0, 0.0, -9.81));
 
 /// Total energy: kinetic + potential.
 inline double total_energy(const WorldMetrics& m) { return m.kinetic_energy + m.potential_energy; }
