@@ -39,3 +39,27 @@ function(impetus_add_plugin kind name)
     install(TARGETS ${target} LIBRARY DESTINATION "${IMPETUS_PLUGIN_INSTALL_DIR}")
   endif()
 endfunction()
+
+# impetus_add_module_library(<target> SOURCES <files...> [INCLUDE_DIR <dir>] [PUBLIC_LIBRARIES <...>]
+#                            [PRIVATE_LIBRARIES <...>])
+#
+# The plain library behind a plugin (STYLE.md: "the algorithm as a plain library that tests can call
+# directly, plus a thin entry file"): STATIC, position-independent so it can go into the plugin's shared
+# object, hidden visibility, built against Impetus::plugin_api (never the core library). INCLUDE_DIR
+# (the folder above the plugin's own, so headers read "euler/euler.hpp") is exported to its users.
+function(impetus_add_module_library target)
+  cmake_parse_arguments(ARG "" "INCLUDE_DIR" "SOURCES;PUBLIC_LIBRARIES;PRIVATE_LIBRARIES" ${ARGN})
+  add_library(${target} STATIC ${ARG_SOURCES})
+  if(ARG_INCLUDE_DIR)
+    target_include_directories(${target} PUBLIC ${ARG_INCLUDE_DIR})
+  endif()
+  target_link_libraries(${target} PUBLIC Impetus::plugin_api ${ARG_PUBLIC_LIBRARIES}
+                                  PRIVATE ${ARG_PRIVATE_LIBRARIES})
+  if(TARGET impetus_compile_options)
+    target_link_libraries(${target} PRIVATE impetus_compile_options)
+  endif()
+  set_target_properties(${target} PROPERTIES
+    POSITION_INDEPENDENT_CODE ON
+    CXX_VISIBILITY_PRESET hidden
+    VISIBILITY_INLINES_HIDDEN ON)
+endfunction()
