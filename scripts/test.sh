@@ -3,6 +3,6 @@
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
 "$root/scripts/setup.sh"
-"$root/scripts/build.sh" -DIMPETUS_BUILD_TESTS=ON
+"$root/scripts/build.sh" -DIMPETUS_BUILD_TESTS=ON -DIMPETUS_BUILD_BENCHMARKS=ON  # benchmarks are built so they keep compiling
 build=${IMPETUS_BUILD_DIR:-$root/build}
 ctest --test-dir "$build" --output-on-failure -j "$(nproc)" "$@"
