@@ -114,7 +114,7 @@ void print_summary(const json& s, std::ostream& out) {
       << "energy                " << e["initial_j"].get<double>() << " J -> " << e["final_j"].get<double>()
       << " J (drift " << e["drift_j"].get<double>() << " J)\n"
       << "momentum drift        linear " << s["linear_momentum_drift"].get<double>() << " kg m/s, angular "
-      << s["angular_momentum_drift"].get<double>() << " kg m^2/s (beyond gravity)\n"
+      << s["angular_momentum_drift"].get<double>() << " kg m^2/s (beyond gravity; contacts with fixed bodies count too)\n"
       << "max penetration       " << s["max_penetration_m"].get<double>() << " m\n";
 }
 
