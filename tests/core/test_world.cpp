@@ -4,6 +4,7 @@
 #include "impetus/core/mass.hpp"
 #include "impetus/core/metrics.hpp"
 #include "impetus/core/world.hpp"
+#include "impetus_test/bodies.hpp"
 
 #include <gtest/gtest.h>
 
@@ -27,13 +28,7 @@ RigidBody sphere(const std::string& name, double radius, double mass, const Vec3
   return b;
 }
 
-RigidBody ground() {
-  RigidBody g;
-  g.name = "ground";
-  g.shape = Plane{};
-  make_fixed(g);
-  return g;
-}
+RigidBody ground() { return test::ground_plane(); }
 
 // Symplectic Euler for translation only; logs its phases.
 class LinearIntegrator : public Integrator {

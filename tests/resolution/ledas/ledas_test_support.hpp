@@ -1,5 +1,6 @@
 #pragma once
 // Hand-built bodies, contacts and tiny analytic detectors for the LEDAS resolver tests (no FCL).
+#include "impetus_test/bodies.hpp"
 #include "impetus/core/mass.hpp"
 #include "impetus/core/metrics.hpp"
 #include "impetus/modules/contact.hpp"
@@ -29,24 +30,8 @@ inline RigidBody sphere(double radius, double mass, const Vec3& position, const 
   return solid(Sphere{radius}, mass, position, velocity, restitution);
 }
 
-inline RigidBody ground_plane(double restitution = 0.0) {
-  RigidBody g;
-  g.name = "ground";
-  g.shape = Plane{};
-  make_fixed(g);
-  g.material.restitution = restitution;
-  return g;
-}
-
-inline Contact contact(BodyIndex a, BodyIndex b, const Vec3& point, const Vec3& normal, double depth = 0.0) {
-  Contact c;
-  c.a = a;
-  c.b = b;
-  c.point = point;
-  c.normal = normal.normalized();
-  c.depth = depth;
-  return c;
-}
+using test::contact;
+using test::ground_plane;
 
 /// One resolution with `resolver`; returns the counters.
 inline ResolverCounters resolve(LedasResolver& resolver, std::vector<RigidBody>& bodies, std::vector<Contact>& contacts,

@@ -2,6 +2,7 @@
 // Hand-built bodies and contacts for the sequential resolver's tests, and the whole-system measures
 // they assert (momentum, energy), computed here independently of the resolver's own algebra.
 #include "impetus/core/body.hpp"
+#include "impetus_test/bodies.hpp"
 #include "impetus/core/mass.hpp"
 #include "impetus/core/metrics.hpp"
 #include "impetus/modules/contact.hpp"
@@ -47,25 +48,9 @@ inline RigidBody box(double mass, const Vec3& size, const Vec3& position, const 
   return b;
 }
 
-/// The fixed ground: the half-space z ≤ 0.
-inline RigidBody ground() {
-  RigidBody b;
-  b.name = "ground";
-  b.shape = Plane{Vec3::UnitZ(), 0.0};
-  make_fixed(b);
-  return b;
-}
-
-/// A contact following the convention (normal out of a into b).
-inline Contact contact(BodyIndex a, BodyIndex b, const Vec3& point, const Vec3& normal, double depth = 0.0) {
-  Contact c;
-  c.a = a;
-  c.b = b;
-  c.point = point;
-  c.normal = normal.normalized();
-  c.depth = depth;
-  return c;
-}
+/// The fixed ground (z ≤ 0) and hand-written contacts.
+inline RigidBody ground() { return test::ground_plane(); }
+using test::contact;
 
 /// Runs the resolver once with `settings` and returns its counters.
 inline ResolverCounters resolve(std::vector<RigidBody>& bodies, std::vector<Contact>& contacts,
