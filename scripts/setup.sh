@@ -8,6 +8,10 @@ packages=(
   libgtest-dev libgmock-dev libbenchmark-dev
   libcli11-dev nlohmann-json3-dev
   binutils python3
+  # peers side by side (benchmarks/peers) and charts (scripts/charts.py)
+  libbullet-dev libode-dev libmujoco-dev python3-matplotlib
+  # fuzzing (libFuzzer) and the sanitizer run
+  clang libclang-rt-dev
 )
 
 as_root=()
