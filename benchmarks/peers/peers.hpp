@@ -1,0 +1,141 @@
+#pragma once
+/// \file
+/// What every peer engine (Bullet, ODE, MuJoCo) and the Impetus rows of `bench_peers` share: one
+/// configured method on one prepared scene, stepped once from the scene's initial state, and what the step
+/// left behind mapped back onto the Impetus bodies and contacts so that bench::measure_quality judges
+/// every engine by the same counters (README.md).
+
+#include "support/bench_scenes.hpp"
+
+#include <cstdint>
+#include <functional>
+#include <limits>
+#include <memory>
+#include <string>
+#include <unordered_map>
+#include <vector>
+
+namespace impetus::peers {
+
+inline constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+
+/// The step everyone takes: dt = 1 ms; gravity off for the impulse problem (the paper's: one solve on the
+/// initial velocities), on for the "full step" rows.
+struct StepSettings {
+  double dt = 1e-3;                  ///< s
+  Vec3 gravity = Vec3::Zero();       ///< m/s²
+};
+
+/// One engine step mapped back onto the Impetus scene. Body and contact indices are the Impetus ones
+/// (PreparedScene::bodies, PreparedScene::contacts).
+struct StepResult {
+  std::vector<Vec3> velocity;           ///< post-step linear velocity per body (m/s)
+  std::vector<Vec3> angular_velocity;   ///< post-step angular velocity per body, world frame (rad/s)
+  /// Normal impulse the engine applied at each Impetus contact (N·s), summed over the engine's contact
+  /// points on the same pair of bodies; empty when the engine exposes none (complementarity is NaN then).
+  std::vector<double> impulses;
+  std::size_t engine_contacts = 0;      ///< contact points the engine generated and solved
+  std::size_t matched = 0;              ///< Impetus contacts with at least one engine point on their pair
+  std::size_t extra = 0;                ///< engine points on a pair the Impetus detector has no contact for
+  double iterations = 0;                ///< solver iterations (setting, or what the engine reports; 0 = direct)
+  double failures = 0;                  ///< the exact solver gave up (Bullet MLCP fallback, ODE LCP error messages)
+  double solver_seconds = kNaN;         ///< the engine's solver alone, if it can be timed separately
+};
+
+/// One method of one engine, configured on one scene. The benchmark calls reset() untimed, step() timed,
+/// and result() once at the end.
+class PeerStep {
+ public:
+  virtual ~PeerStep() = default;
+  /// Back to the scene's initial state (positions, velocities; no warm start, no cached impulses).
+  virtual void reset() = 0;
+  /// One engine step (contact generation + solve + integration), or the resolver alone for Impetus.
+  virtual void step() = 0;
+  /// The state after the last step().
+  virtual StepResult result() = 0;
+};
+
+/// A benchmark row family: "bullet_si_10", "ode_worldstep_cfm0", …
+struct Method {
+  std::string name;
+  /// false: skip the e = 1 line rows (the engine has no Newton restitution to compare).
+  bool restitution = true;
+  /// Largest scene (movable bodies) this method is run on; dense direct solvers grow as n³.
+  std::size_t max_bodies = std::size_t(1) << 40;
+  std::function<std::unique_ptr<PeerStep>(const bench::PreparedScene&, const StepSettings&)> make;
+};
+
+/// The methods each engine offers (defined in bullet.cpp, ode.cpp, mujoco.cpp, impetus_rows.cpp).
+void add_bullet_methods(std::vector<Method>& out);
+void add_ode_methods(std::vector<Method>& out);
+void add_mujoco_methods(std::vector<Method>& out);
+void add_impetus_methods(std::vector<Method>& out);
+/// Engine name and version for the start-up banner.
+std::string bullet_description();
+std::string ode_description();
+std::string mujoco_description();
+
+/// Finds the Impetus contact on an unordered pair of Impetus bodies (each pair of spheres, or a sphere
+/// and a plane, touches at one point in these scenes).
+class PairIndex {
+ public:
+  explicit PairIndex(const std::vector<Contact>& contacts) {
+    for (std::size_t k = 0; k < contacts.size(); ++k) index_.emplace(key(contacts[k].a, contacts[k].b), k);
+  }
+  /// The contact index, or -1 when the pair has none.
+  long find(std::size_t i, std::size_t j) const {
+    const auto it = index_.find(key(i, j));
+    return it == index_.end() ? -1 : static_cast<long>(it->second);
+  }
+
+ private:
+  static std::uint64_t key(std::size_t i, std::size_t j) {
+    if (i > j) std::swap(i, j);
+    return (static_cast<std::uint64_t>(i) << 32) | static_cast<std::uint64_t>(j);
+  }
+  std::unordered_map<std::uint64_t, std::size_t> index_;
+};
+
+/// Collects an engine's contact points into a StepResult: each point on Impetus bodies (i, j) with the
+/// normal impulse `impulse` (N·s; NaN when unknown) is added to the matching Impetus contact.
+class ContactTally {
+ public:
+  ContactTally(const PairIndex& pairs, std::size_t contact_count, bool impulses_known)
+      : pairs_(pairs), impulses_(contact_count, 0.0), hit_(contact_count, false), known_(impulses_known) {}
+
+  void add(std::size_t i, std::size_t j, double impulse) {
+    ++points_;
+    const long k = pairs_.find(i, j);
+    if (k < 0) {
+      ++extra_;
+      return;
+    }
+    hit_[static_cast<std::size_t>(k)] = true;
+    impulses_[static_cast<std::size_t>(k)] += impulse;
+  }
+
+  /// Writes the counts and impulses into `out`.
+  void finish(StepResult& out) {
+    out.engine_contacts = points_;
+    out.extra = extra_;
+    out.matched = static_cast<std::size_t>(std::count(hit_.begin(), hit_.end(), true));
+    if (known_) out.impulses = std::move(impulses_);
+  }
+
+ private:
+  const PairIndex& pairs_;
+  std::vector<double> impulses_;
+  std::vector<bool> hit_;
+  bool known_;
+  std::size_t points_ = 0, extra_ = 0;
+};
+
+/// Index of the scene's single fixed body (ground or wall, last in PreparedScene::bodies).
+inline std::size_t fixed_body(const bench::PreparedScene& scene) { return scene.bodies.size() - 1; }
+
+/// Sphere radius and mass of the scene (all spheres are equal in the benchmark scenes).
+inline double sphere_radius(const bench::PreparedScene& scene) {
+  return std::get<Sphere>(scene.bodies.front().shape).radius;
+}
+
+}  // namespace impetus::peers

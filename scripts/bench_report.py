@@ -1,0 +1,371 @@
+#!/usr/bin/env python3
+"""Turns the benchmark suites' JSON output into docs/benchmarks.md and the scaling charts.
+
+Usage: bench_report.py DATA_DIR DOCS_DIR
+
+DATA_DIR holds Google Benchmark JSON files (--benchmark_format=json): resolve.json, step.json,
+detect.json and, when the peers benchmark was built, peers.json. Medians are used where the run had
+repetitions (aggregate "median"), else the single run. Writes DOCS_DIR/benchmarks.md and
+DOCS_DIR/charts/scaling.{png,svg} (and peers.{png,svg} with peers.json). Charts need matplotlib; without
+it the tables are still written and the charts are skipped with a message.
+"""
+import json
+import math
+import os
+import platform
+import re
+import subprocess
+import sys
+
+# The paper's table (sec. 5; shared/DESIGN.md, "Benchmark scenes"): name, bodies, contacts, seconds,
+# and the Impetus scene that reproduces it.
+PAPER = [
+    ("Line", 10, 10, 0.00085, "line_10_e0"),
+    ("Line", 100, 100, 0.2415, "line_100_e0"),
+    ("Pyramid", 6, 9, 0.00013, "pyramid_3"),
+    ("Pyramid", 10, 18, 0.00017, "pyramid_4"),
+    ("Pyramid", 55, 135, 0.0023, "pyramid_10"),
+    ("Pyramid", 210, 570, 6.501, "pyramid_20"),
+]
+RESOLVERS = ["ledas", "ledas_paper", "mirtich"]
+LABELS = {"ledas": "ledas complementary", "ledas_paper": "ledas paper mode", "mirtich": "mirtich (sequential)"}
+UNIT = {"ns": 1e-9, "us": 1e-6, "ms": 1e-3, "s": 1.0}
+
+
+def load(path):
+    """Rows of a Google Benchmark JSON file by run name: the median aggregate, else the single run."""
+    if not os.path.exists(path):
+        return None
+    with open(path) as f:
+        data = json.load(f)
+    rows = {}
+    for b in data.get("benchmarks", []):
+        name = b.get("run_name", b["name"])
+        if b.get("run_type") == "aggregate" and b.get("aggregate_name") != "median":
+            continue
+        if "error_occurred" in b and b["error_occurred"]:
+            rows[name] = {"error": b.get("error_message", "error")}
+            continue
+        row = dict(b)
+        row["seconds"] = b["real_time"] * UNIT[b.get("time_unit", "ns")]
+        rows[name] = row
+    return {"context": data.get("context", {}), "rows": rows}
+
+
+def seconds(t):
+    """A time in the unit that reads best."""
+    if t is None or (isinstance(t, float) and math.isnan(t)):
+        return "—"
+    if t >= 1:
+        return f"{t:.3g} s"
+    if t >= 1e-3:
+        return f"{t * 1e3:.3g} ms"
+    return f"{t * 1e6:.3g} µs"
+
+
+def sci(x):
+    if x is None or (isinstance(x, float) and math.isnan(x)):
+        return "—"
+    return "0" if x == 0 else f"{x:.1e}"
+
+
+def speedup(x):
+    return f"{x:,.0f}×" if x >= 10 else f"{x:.2g}×"
+
+
+def fit_exponent(points):
+    """Least-squares slope k of log t = k log n + c over (n, t) points; None for fewer than 3."""
+    pts = [(math.log(n), math.log(t)) for n, t in points if n > 0 and t > 0]
+    if len(pts) < 3:
+        return None
+    mx = sum(p[0] for p in pts) / len(pts)
+    my = sum(p[1] for p in pts) / len(pts)
+    sxx = sum((p[0] - mx) ** 2 for p in pts)
+    sxy = sum((p[0] - mx) * (p[1] - my) for p in pts)
+    return sxy / sxx
+
+
+def scene_order(scene):
+    m = re.match(r"(pyramid|line)_(\d+)(?:_e(\d))?", scene)
+    return (m.group(1) != "pyramid", int(m.group(2)), m.group(3) or "")
+
+
+def machine(context):
+    """One line describing the machine, the compiler and the benchmark library's context."""
+    cpu = platform.processor() or "unknown CPU"
+    try:
+        with open("/proc/cpuinfo") as f:
+            for line in f:
+                if line.startswith("model name"):
+                    cpu = line.split(":", 1)[1].strip()
+                    break
+    except OSError:
+        pass
+    try:
+        compiler = subprocess.run(["c++", "--version"], capture_output=True, text=True).stdout.splitlines()[0]
+    except (OSError, IndexError):
+        compiler = "unknown compiler"
+    distro = ""
+    try:
+        with open("/etc/os-release") as f:
+            distro = dict(l.rstrip().split("=", 1) for l in f if "=" in l).get("PRETTY_NAME", "").strip('"')
+    except OSError:
+        pass
+    return (f"{cpu}, {context.get('num_cpus', '?')} cores at {context.get('mhz_per_cpu', '?')} MHz, {distro}, "
+            f"{compiler}, Impetus built {context.get('impetus_build_type', '?')}, run {context.get('date', '?')}; "
+            f"one thread")
+
+
+def by_scene(rows, family):
+    """{resolver: {scene: row}} for rows named family/resolver/scene."""
+    out = {}
+    for name, row in rows.items():
+        parts = name.split("/")
+        if len(parts) != 3 or parts[0] != family:
+            continue
+        out.setdefault(parts[1], {})[parts[2]] = row
+    return out
+
+
+def paper_table(res):
+    lines = ["| Scene | Bodies | Contacts (paper) | Paper (s) | " +
+             " | ".join(f"{LABELS[r]}: time · speed-up · residual" for r in RESOLVERS) + " |",
+             "|---|---:|---:|---:|" + "---|" * len(RESOLVERS)]
+    for name, bodies, contacts, t_paper, scene in PAPER:
+        cells = []
+        for r in RESOLVERS:
+            row = res.get(r, {}).get(scene)
+            if not row or "error" in row:
+                cells.append("—")
+                continue
+            exact = "exact" if row.get("exact", 0) >= 1 else f"residual {sci(row.get('residual'))}"
+            cells.append(f"{seconds(row['seconds'])} · {speedup(t_paper / row['seconds'])} · {exact}")
+        lines.append(f"| {name} | {bodies} | {contacts} | {t_paper} | " + " | ".join(cells) + " |")
+    return "\n".join(lines)
+
+
+def full_table(res):
+    scenes = sorted({s for r in res.values() for s in r}, key=scene_order)
+    lines = ["| Scene | Bodies | Contacts | Resolver | Time (median) | Rounds / impulses | Pulling | "
+             "Residual (m/s) | Complementarity | Exact | Not converged |",
+             "|---|---:|---:|---|---:|---:|---:|---:|---:|:-:|:-:|"]
+    for scene in scenes:
+        for r in RESOLVERS:
+            row = res.get(r, {}).get(scene)
+            if not row:
+                continue
+            if "error" in row:
+                lines.append(f"| {scene} | | | {r} | error: {row['error']} | | | | | | |")
+                continue
+            lines.append(
+                f"| {scene} | {row['bodies']:.0f} | {row['contacts']:.0f} | {r} | {seconds(row['seconds'])} | "
+                f"{row['rounds']:,.0f} | {row['pulling']:,.0f} | {sci(row['residual'])} | "
+                f"{sci(row['complementarity'])} | {'yes' if row['exact'] >= 1 else 'no'} | "
+                f"{'yes' if row['non_converged'] > 0 else ''} |")
+    return "\n".join(lines)
+
+
+def scaling(res):
+    """{resolver: {"pyramid": k, "line_e0": k, "line_e1": k}} fitted over contacts."""
+    fits = {}
+    for r, scenes in res.items():
+        fam = {"pyramid": [], "line_e0": [], "line_e1": []}
+        for scene, row in scenes.items():
+            if "error" in row:
+                continue
+            key = "pyramid" if scene.startswith("pyramid") else ("line_e1" if scene.endswith("_e1") else "line_e0")
+            fam[key].append((row["contacts"], row["seconds"]))
+        fits[r] = {k: fit_exponent(v) for k, v in fam.items()}
+    return fits
+
+
+def scaling_table(fits):
+    lines = ["| Resolver | k, pyramid K = 3…100 | k, line e = 0 | k, line e = 1 |", "|---|---:|---:|---:|"]
+    for r in RESOLVERS:
+        if r not in fits:
+            continue
+        f = fits[r]
+        cell = lambda k: "—" if f.get(k) is None else f"{f[k]:.2f}"
+        lines.append(f"| {LABELS[r]} | {cell('pyramid')} | {cell('line_e0')} | {cell('line_e1')} |")
+    return "\n".join(lines)
+
+
+def step_table(steps):
+    scenes = sorted({s for r in steps.values() for s in r}, key=scene_order)
+    lines = ["| Scene | Resolver | Step (median) | velocities | detect | resolve | positions | resolve share |",
+             "|---|---|---:|---:|---:|---:|---:|---:|"]
+    for scene in scenes:
+        for r in RESOLVERS:
+            row = steps.get(r, {}).get(scene)
+            if not row or "error" in row:
+                continue
+            ms = lambda k: seconds(row[k] * 1e-3)
+            lines.append(f"| {scene} | {r} | {seconds(row['seconds'])} | {ms('velocities_ms')} | {ms('detect_ms')} | "
+                         f"{ms('resolve_ms')} | {ms('positions_ms')} | {100 * row['resolve_share']:.0f}% |")
+    return "\n".join(lines)
+
+
+def detect_table(rows):
+    lines = ["| Scene | Bodies | Contacts | Detect (median) | broadphase | narrowphase |", "|---|---:|---:|---:|---:|---:|"]
+    for name, row in sorted(rows.items()):
+        if not name.startswith("detect/") or "error" in row:
+            continue
+        lines.append(f"| {name[7:]} | {row['bodies']:.0f} | {row['contacts']:.0f} | {seconds(row['seconds'])} | "
+                     f"{seconds(row['broadphase_ms'] * 1e-3)} | {seconds(row['narrowphase_ms'] * 1e-3)} |")
+    return "\n".join(lines)
+
+
+def peers_table(rows):
+    """Rows named peers/<method>/<scene>, sorted by scene then time."""
+    entries = []
+    for name, row in rows.items():
+        parts = name.split("/")
+        if len(parts) != 3 or "error" in row:
+            continue
+        entries.append((parts[2], parts[1], row))
+    entries.sort(key=lambda e: (scene_order(e[0]), e[2]["seconds"]))
+    lines = ["| Scene | Method | Time (median) | Residual (m/s) | Complementarity | Energy change | Exact |",
+             "|---|---|---:|---:|---:|---:|:-:|"]
+    for scene, method, row in entries:
+        lines.append(f"| {scene} | {method} | {seconds(row['seconds'])} | {sci(row.get('residual'))} | "
+                     f"{sci(row.get('complementarity'))} | {sci(row.get('energy_change'))} | "
+                     f"{'yes' if row.get('exact', 0) >= 1 else 'no'} |")
+    return "\n".join(lines)
+
+
+def charts(res, peers, out_dir):
+    try:
+        import matplotlib
+        matplotlib.use("Agg")
+        import matplotlib.pyplot as plt
+    except ImportError:
+        print("bench_report: matplotlib not installed (apt-get install python3-matplotlib): charts skipped")
+        return []
+    os.makedirs(out_dir, exist_ok=True)
+    written = []
+    fig, axes = plt.subplots(1, 2, figsize=(12, 5))
+    markers = {"ledas": "o", "ledas_paper": "s", "mirtich": "^"}
+    for ax, family in zip(axes, ["pyramid", "line"]):
+        ringed = False
+        for r in RESOLVERS:
+            pts = sorted((row["contacts"], row["seconds"], row["exact"] >= 1) for s, row in res.get(r, {}).items()
+                         if "error" not in row and s.startswith(family) and not s.endswith("_e1"))
+            if not pts:
+                continue
+            ax.plot([p[0] for p in pts], [p[1] for p in pts], marker=markers[r], label=LABELS[r])
+            wrong = [p for p in pts if not p[2]]
+            if wrong:
+                ax.scatter([p[0] for p in wrong], [p[1] for p in wrong], s=140, facecolors="none",
+                           edgecolors="red", zorder=5, label=None if ringed else "not exact (residual or complementarity > 1e-9)")
+                ringed = True
+        paper = [(c, t) for name, _, c, t, _ in PAPER if name.lower() == family]
+        ax.scatter([p[0] for p in paper], [p[1] for p in paper], marker="*", s=160, color="black",
+                   label="paper (sec. 5)", zorder=6)
+        ax.set_xscale("log")
+        ax.set_yscale("log")
+        ax.set_xlabel("contacts")
+        ax.set_ylabel("resolver time (s)")
+        ax.set_title(f"{family}: resolver alone, e = 0" + (" (sphere pyramid drop)" if family == "pyramid" else " (line push)"))
+        ax.grid(True, which="both", alpha=0.3)
+        ax.legend(fontsize=8)
+    fig.tight_layout()
+    for ext in ("png", "svg"):
+        path = os.path.join(out_dir, f"scaling.{ext}")
+        fig.savefig(path, dpi=110)
+        written.append(path)
+    plt.close(fig)
+
+    if peers:
+        entries = {}
+        for name, row in peers.items():
+            parts = name.split("/")
+            if len(parts) == 3 and "error" not in row:
+                entries.setdefault(parts[2], []).append((parts[1], row))
+        scenes = sorted(entries, key=scene_order)
+        if scenes:
+            cols = min(3, len(scenes))
+            rows_n = (len(scenes) + cols - 1) // cols
+            fig, axes = plt.subplots(rows_n, cols, figsize=(5.5 * cols, 4.5 * rows_n), squeeze=False)
+            floor = 1e-17
+            for ax, scene in zip(axes.flat, scenes):
+                for method, row in sorted(entries[scene]):
+                    y = max(row.get("residual", 0.0) or 0.0, floor)
+                    ax.scatter(row["seconds"], y, label=method, marker="o" if method.startswith("impetus") else "x")
+                    ax.annotate(method, (row["seconds"], y), fontsize=6, alpha=0.8)
+                ax.set_xscale("log")
+                ax.set_yscale("log")
+                ax.set_xlabel("time per solve (s)")
+                ax.set_ylabel(f"residual approach velocity (m/s, floor {floor:g})")
+                ax.set_title(scene)
+                ax.grid(True, which="both", alpha=0.3)
+            for ax in list(axes.flat)[len(scenes):]:
+                ax.axis("off")
+            fig.tight_layout()
+            for ext in ("png", "svg"):
+                path = os.path.join(out_dir, f"peers.{ext}")
+                fig.savefig(path, dpi=110)
+                written.append(path)
+            plt.close(fig)
+    return written
+
+
+def main():
+    if len(sys.argv) != 3:
+        sys.exit(__doc__)
+    data_dir, docs_dir = sys.argv[1], sys.argv[2]
+    resolve = load(os.path.join(data_dir, "resolve.json"))
+    if resolve is None:
+        sys.exit(f"bench_report: {data_dir}/resolve.json not found (run scripts/bench.sh)")
+    step = load(os.path.join(data_dir, "step.json"))
+    detect = load(os.path.join(data_dir, "detect.json"))
+    peers = load(os.path.join(data_dir, "peers.json"))
+    res = by_scene(resolve["rows"], "resolve")
+    fits = scaling(res)
+
+    out = ["# Benchmarks", "",
+           "Generated by `bash scripts/bench.sh` (which runs the suites in `benchmarks/` and then "
+           "`scripts/bench_report.py`); do not edit by hand.", "",
+           f"Machine: {machine(resolve['context'])}.", "",
+           "Times are medians of the repetitions. *Residual* is the largest approach velocity left after the "
+           "solve and *complementarity* the largest |p·v⁺| over the contacts, both measured from the bodies' "
+           "velocities, not reported by the resolver; *exact* means both ≤ 1e-9. See `benchmarks/resolve.cpp`.", "",
+           "## The paper's table (sec. 5), regenerated", "",
+           "The resolver alone on the prepared contact list (detection outside the timed loop), velocity phase "
+           "only. Speed-up = paper's time / Impetus' time on this machine (the paper's machine is unknown, so the "
+           "ratio compares methods and implementations together). Impetus' pyramids also carry the K ground "
+           "contacts the paper's counts leave out.", "",
+           paper_table(res), "",
+           "![Resolver time against contacts](charts/scaling.png)", "",
+           "## Scaling exponents", "",
+           "Least-squares fit of log time = k log contacts + c over each family (all rows, exact or not).", "",
+           scaling_table(fits), "",
+           "## Every row of the `resolve` family", "",
+           full_table(res), ""]
+    if step:
+        out += ["## A whole step under gravity (`step` family)", "",
+                "Detect + resolve + integrate from the drop/push state, position correction on; the stage split "
+                "comes from the world's step profile.", "",
+                step_table(by_scene(step["rows"], "step")), ""]
+    if detect:
+        out += ["## Detection alone (`detect` family)", "", detect_table(detect["rows"]), ""]
+    if peers:
+        out += ["## Peers side by side (`peers` benchmark)", "",
+                "Same initial state, same contact list for the residuals; see `benchmarks/peers/README.md` for "
+                "what each engine's row times and which settings are as shipped or regularized.", "",
+                "![Time against residual, Impetus and peers](charts/peers.png)", "",
+                peers_table(peers["rows"]), ""]
+    else:
+        out += ["## Peers", "", "No `peers.json`: the peers benchmark was not built (Bullet, ODE, MuJoCo not "
+                "installed) or not run.", ""]
+    os.makedirs(docs_dir, exist_ok=True)
+    with open(os.path.join(docs_dir, "benchmarks.md"), "w") as f:
+        f.write("\n".join(out))
+    written = charts(res, peers["rows"] if peers else None, os.path.join(docs_dir, "charts"))
+    print(f"bench_report: wrote {os.path.join(docs_dir, 'benchmarks.md')}" + "".join(f", {w}" for w in written))
+    for r in RESOLVERS:
+        if r in fits:
+            print(f"  scaling {r}: " + ", ".join(f"{k} k={v:.2f}" for k, v in fits[r].items() if v is not None))
+
+
+if __name__ == "__main__":
+    main()
