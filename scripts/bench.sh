@@ -31,6 +31,7 @@ run() {  # run NAME [extra args]: bench_NAME → docs/data/NAME.json
 run resolve
 run step
 run detect
+run model
 if [ -x "$build/bin/bench_peers" ]; then run peers; else rm -f "$data/peers.json"; echo "== bench_peers not built (no Bullet/ODE/MuJoCo): skipped"; fi
 "$py" "$root/scripts/bench_report.py" "$data" "$root/docs"
 

@@ -215,6 +215,30 @@ def detect_table(rows):
     return "\n".join(lines)
 
 
+MODEL_TEXT = {
+    "fixed_bodies": "16 pyramids (K = 6) on a fixed ground (on) or on a movable 10⁹ kg ground box (off)",
+    "islands": "the same 16 pyramids solved island by island (on) or as one system (off)",
+    "primitives": "pyramid K = 10 of analytic spheres (on) or of 642-vertex convex icosphere meshes (off)",
+    "contact_reduction": "10 boxes, each turned 45°: ≤ 4 points per pair (on) or all 8 octagon corners (off)",
+}
+
+
+def model_table(rows):
+    lines = ["| Lever | Scene | Step on | Step off | Off / on | Contacts on / off | Islands on / off | "
+             "detect on / off | resolve on / off |", "|---|---|---:|---:|---:|---:|---:|---:|---:|"]
+    for lever, text in MODEL_TEXT.items():
+        on, off = rows.get(f"model/{lever}/on"), rows.get(f"model/{lever}/off")
+        if not on or not off or "error" in on or "error" in off:
+            lines.append(f"| {lever} | {text} | — | — | — | | | | |")
+            continue
+        ms = lambda r, k: seconds(r[k] * 1e-3)
+        lines.append(f"| {lever} | {text} | {seconds(on['seconds'])} | {seconds(off['seconds'])} | "
+                     f"{off['seconds'] / on['seconds']:.1f}× | {on['contacts']:.0f} / {off['contacts']:.0f} | "
+                     f"{on['islands']:.0f} / {off['islands']:.0f} | {ms(on, 'detect_ms')} / {ms(off, 'detect_ms')} | "
+                     f"{ms(on, 'resolve_ms')} / {ms(off, 'resolve_ms')} |")
+    return "\n".join(lines)
+
+
 def peers_table(rows):
     """Rows named peers/<method>/<scene>, sorted by scene then time."""
     entries = []
@@ -319,6 +343,7 @@ def main():
     step = load(os.path.join(data_dir, "step.json"))
     detect = load(os.path.join(data_dir, "detect.json"))
     peers = load(os.path.join(data_dir, "peers.json"))
+    model = load(os.path.join(data_dir, "model.json"))
     res = by_scene(resolve["rows"], "resolve")
     fits = scaling(res)
 
@@ -348,6 +373,10 @@ def main():
                 step_table(by_scene(step["rows"], "step")), ""]
     if detect:
         out += ["## Detection alone (`detect` family)", "", detect_table(detect["rows"]), ""]
+    if model:
+        out += ["## Model no more than a scene needs (`model` family)", "",
+                "Each lever of shared/DESIGN.md switched on and off on the same scene; one whole step from the "
+                "same state per iteration (`benchmarks/model.cpp`).", "", model_table(model["rows"]), ""]
     if peers:
         out += ["## Peers side by side (`peers` benchmark)", "",
                 "Same initial state, same contact list for the residuals; see `benchmarks/peers/README.md` for "

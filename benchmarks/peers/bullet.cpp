@@ -1,1 +1,210 @@
+// Bullet (double-precision build, BT_USE_DOUBLE_PRECISION from pkg-config bullet-float64) on the peers'
+// scenes: a btDiscreteDynamicsWorld with the same spheres and planes, stepped once with dt.
+//
+// Settings for the impulse problem: contact and friction ERP 0 and split impulse off (so the velocities
+// are the velocity solve's and nothing else), friction 0, restitution e on every body (Bullet multiplies
+// the two bodies' coefficients), no damping, no deactivation. Every reset clears the contact manifolds,
+// so no step is warm-started from the previous one.
+#include "peers.hpp"
 
+#include <btBulletDynamicsCommon.h>
+#include <BulletDynamics/MLCPSolvers/btDantzigSolver.h>
+#include <BulletDynamics/MLCPSolvers/btMLCPSolver.h>
+
+#include <chrono>
+
+static_assert(sizeof(btScalar) == sizeof(double), "bench_peers needs Bullet's double-precision build");
+
+namespace impetus::peers {
+namespace {
+
+btVector3 to_bt(const Vec3& v) { return btVector3(v.x(), v.y(), v.z()); }
+Vec3 from_bt(const btVector3& v) { return Vec3(v.x(), v.y(), v.z()); }
+
+/// A Bullet solver whose solveGroup calls (setup + iterations + write-back) are timed.
+template <class Solver>
+class TimedSolver final : public Solver {
+ public:
+  using Solver::Solver;
+  btScalar solveGroup(btCollisionObject** bodies, int num_bodies, btPersistentManifold** manifolds,
+                      int num_manifolds, btTypedConstraint** constraints, int num_constraints,
+                      const btContactSolverInfo& info, btIDebugDraw* debug, btDispatcher* dispatcher) override {
+    const auto start = std::chrono::steady_clock::now();
+    const btScalar r = Solver::solveGroup(bodies, num_bodies, manifolds, num_manifolds, constraints,
+                                          num_constraints, info, debug, dispatcher);
+    seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    return r;
+  }
+  double seconds = 0.0;
+};
+
+using SiSolver = TimedSolver<btSequentialImpulseConstraintSolver>;
+using MlcpSolver = TimedSolver<btMLCPSolver>;
+
+struct BulletConfig {
+  bool mlcp = false;          ///< btMLCPSolver + btDantzigSolver, else sequential impulse
+  int iterations = 10;        ///< SI iterations (also the MLCP's fallback)
+  double global_cfm = 0.0;    ///< regularization: Bullet adds cfm/dt to the MLCP's diagonal
+};
+
+class BulletStep final : public PeerStep {
+ public:
+  BulletStep(const bench::PreparedScene& scene, const StepSettings& settings, const BulletConfig& config)
+      : scene_(scene), settings_(settings), config_(config), pairs_(scene.contacts),
+        dispatcher_(&collision_config_), sphere_(sphere_radius(scene)) {
+    if (config.mlcp) {
+      auto solver = std::make_unique<MlcpSolver>(&dantzig_);
+      mlcp_ = solver.get();
+      solver_ = std::move(solver);
+    } else {
+      solver_ = std::make_unique<SiSolver>();
+    }
+    world_ = std::make_unique<btDiscreteDynamicsWorld>(&dispatcher_, &broadphase_, solver_.get(), &collision_config_);
+    world_->setGravity(to_bt(settings.gravity));
+    btContactSolverInfo& info = world_->getSolverInfo();
+    info.m_numIterations = config.iterations;
+    info.m_erp = 0.0;
+    info.m_erp2 = 0.0;
+    info.m_frictionERP = 0.0;
+    info.m_splitImpulse = 0;
+    info.m_globalCfm = config.global_cfm;
+    add_bodies();
+  }
+
+  ~BulletStep() override {
+    for (auto& body : bodies_) world_->removeRigidBody(body.get());
+  }
+
+  void reset() override {
+    for (std::size_t i = 0; i < bodies_.size(); ++i) {
+      const RigidBody& b = scene_.bodies[i];
+      if (b.fixed) continue;
+      btRigidBody& body = *bodies_[i];
+      btTransform pose;
+      pose.setIdentity();
+      pose.setOrigin(to_bt(b.position));
+      body.setWorldTransform(pose);
+      body.setInterpolationWorldTransform(pose);
+      body.setLinearVelocity(to_bt(b.velocity));
+      body.setAngularVelocity(to_bt(b.angular_velocity));
+      body.setInterpolationLinearVelocity(to_bt(b.velocity));
+      body.setInterpolationAngularVelocity(to_bt(b.angular_velocity));
+      body.clearForces();
+    }
+    // No warm start: the contact points (and their cached impulses) of the last step are dropped.
+    for (int m = 0; m < dispatcher_.getNumManifolds(); ++m) dispatcher_.getManifoldByIndexInternal(m)->clearManifold();
+    solver_seconds_before_ = solver_seconds();
+    fallbacks_before_ = mlcp_ ? mlcp_->getNumFallbacks() : 0;
+  }
+
+  void step() override {
+    // maxSubSteps = 0: exactly one internal step of length dt.
+    world_->stepSimulation(settings_.dt, 0);
+  }
+
+  StepResult result() override {
+    StepResult r;
+    for (const auto& body : bodies_) {
+      r.velocity.push_back(from_bt(body->getLinearVelocity()));
+      r.angular_velocity.push_back(from_bt(body->getAngularVelocity()));
+    }
+    ContactTally tally(pairs_, scene_.contacts.size(), true);
+    for (int m = 0; m < dispatcher_.getNumManifolds(); ++m) {
+      const btPersistentManifold& manifold = *dispatcher_.getManifoldByIndexInternal(m);
+      const auto i = static_cast<std::size_t>(manifold.getBody0()->getUserIndex());
+      const auto j = static_cast<std::size_t>(manifold.getBody1()->getUserIndex());
+      for (int p = 0; p < manifold.getNumContacts(); ++p) tally.add(i, j, manifold.getContactPoint(p).getAppliedImpulse());
+    }
+    tally.finish(r);
+    r.iterations = config_.iterations;
+    r.failures = mlcp_ ? mlcp_->getNumFallbacks() - fallbacks_before_ : 0.0;
+    r.solver_seconds = solver_seconds() - solver_seconds_before_;
+    return r;
+  }
+
+ private:
+  double solver_seconds() const {
+    if (mlcp_) return mlcp_->seconds;
+    return static_cast<const SiSolver*>(solver_.get())->seconds;
+  }
+
+  void add_bodies() {
+    const double restitution = scene_.bodies.front().material.restitution;
+    for (std::size_t i = 0; i < scene_.bodies.size(); ++i) {
+      const RigidBody& b = scene_.bodies[i];
+      std::unique_ptr<btRigidBody> body;
+      if (b.fixed) {
+        const Plane& plane = std::get<Plane>(b.shape);
+        // Both use "solid below the plane, normal pointing out of it": n·p ≤ offset.
+        plane_ = std::make_unique<btStaticPlaneShape>(to_bt(plane.normal), plane.offset);
+        body = std::make_unique<btRigidBody>(btRigidBody::btRigidBodyConstructionInfo(0.0, nullptr, plane_.get()));
+      } else {
+        btVector3 inertia;
+        sphere_.calculateLocalInertia(b.mass, inertia);  // 2/5 m r², as Impetus
+        btRigidBody::btRigidBodyConstructionInfo info(b.mass, nullptr, &sphere_, inertia);
+        info.m_startWorldTransform.setOrigin(to_bt(b.position));
+        body = std::make_unique<btRigidBody>(info);
+        body->setActivationState(DISABLE_DEACTIVATION);
+      }
+      body->setFriction(0.0);
+      body->setRollingFriction(0.0);
+      body->setSpinningFriction(0.0);
+      body->setRestitution(restitution);
+      body->setUserIndex(static_cast<int>(i));
+      world_->addRigidBody(body.get());
+      bodies_.push_back(std::move(body));
+    }
+    reset();
+  }
+
+  const bench::PreparedScene& scene_;
+  StepSettings settings_;
+  BulletConfig config_;
+  PairIndex pairs_;
+  btDefaultCollisionConfiguration collision_config_;
+  btCollisionDispatcher dispatcher_;
+  btDbvtBroadphase broadphase_;
+  btDantzigSolver dantzig_;
+  std::unique_ptr<btConstraintSolver> solver_;
+  MlcpSolver* mlcp_ = nullptr;
+  std::unique_ptr<btDiscreteDynamicsWorld> world_;
+  btSphereShape sphere_;
+  std::unique_ptr<btStaticPlaneShape> plane_;
+  std::vector<std::unique_ptr<btRigidBody>> bodies_;
+  double solver_seconds_before_ = 0.0;
+  int fallbacks_before_ = 0;
+};
+
+Method bullet_method(std::string name, const BulletConfig& config, std::size_t max_bodies) {
+  Method m;
+  m.name = std::move(name);
+  m.max_bodies = max_bodies;
+  m.make = [config](const bench::PreparedScene& scene, const StepSettings& settings) {
+    return std::make_unique<BulletStep>(scene, settings, config);
+  };
+  return m;
+}
+
+}  // namespace
+
+std::string bullet_description() {
+  const int v = btGetVersion();
+  return "Bullet " + std::to_string(v / 100) + "." + std::to_string(v % 100) + " (double precision)";
+}
+
+void add_bullet_methods(std::vector<Method>& out) {
+  for (int iterations : {10, 50, 200}) {
+    BulletConfig c;
+    c.iterations = iterations;
+    out.push_back(bullet_method("bullet_si_" + std::to_string(iterations), c, std::size_t(1) << 40));
+  }
+  // The Dantzig MLCP builds a dense matrix of 2 rows per contact (normal + one friction row): pyramid 50
+  // would need ~0.5 GB, so it stops at 1000 bodies.
+  BulletConfig mlcp;
+  mlcp.mlcp = true;
+  out.push_back(bullet_method("bullet_mlcp", mlcp, 1000));
+  mlcp.global_cfm = 1e-8;
+  out.push_back(bullet_method("bullet_mlcp_cfm", mlcp, 1000));
+}
+
+}  // namespace impetus::peers

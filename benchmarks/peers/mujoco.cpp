@@ -1,1 +1,193 @@
+// MuJoCo on the peers' scenes: a model built from an MJCF string (loaded through a virtual file system):
+// one free body per sphere (geom sphere, mass 1, so inertia 2/5 m r² as Impetus), the fixed plane as a
+// world geom, every geom condim = 1 (frictionless), Euler integrator, dt, gravity as set; solver PGS, CG or
+// Newton with iterations 100 and tolerance 1e-10. One mj_step from mj_resetData (no warm start).
+//
+// MuJoCo's contacts are soft (DESIGN of MuJoCo, "solver parameters"): the solve gives J a = d·a_ref with
+// impedance d < 1 and a_ref = −b v − k r, not the hard v_n⁺ = 0. Two settings:
+//   default   solref/solimp as shipped (0.02 1 / 0.9 0.95 0.001 0.5 2): a contact absorbs only part of the
+//             approach velocity per step (the spring-damper reference), by design.
+//   stiff     the hardest MuJoCo allows: solimp 0.9999 (its clamp mjMAXIMP) everywhere, and solref in the
+//             direct form "0 −1/dt" (stiffness 0: no position term; damping 1/dt: a_ref·dt = −v, so a hard
+//             contact would stop exactly in one step).
+#include "peers.hpp"
 
+#include <mujoco/mujoco.h>
+
+#include <chrono>
+#include <cstdio>
+#include <sstream>
+#include <stdexcept>
+
+namespace impetus::peers {
+namespace {
+
+/// mjcb_time for d->timer: seconds on the steady clock.
+mjtNum steady_seconds() {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
+}
+
+struct MujocoConfig {
+  int solver = mjSOL_NEWTON;
+  bool stiff = false;
+  int iterations = 100;
+  double tolerance = 1e-10;
+};
+
+std::string vec(const Vec3& v) {
+  std::ostringstream s;
+  s.precision(17);
+  s << v.x() << ' ' << v.y() << ' ' << v.z();
+  return s.str();
+}
+
+/// The scene as MJCF: spheres in Impetus order (body k + 1 is Impetus body k), the plane as world geom 0.
+std::string make_mjcf(const bench::PreparedScene& scene, const StepSettings& settings, const MujocoConfig& config) {
+  std::ostringstream x;
+  x.precision(17);
+  // Contacts per sphere are at most 6 here; size the buffers for pyramid 50 without the defaults' caps.
+  const std::size_t capacity = 8 * scene.bodies.size() + 100;
+  x << "<mujoco model=\"peers\">\n"
+    << "  <size nconmax=\"" << capacity << "\" njmax=\"" << capacity << "\"/>\n"
+    << "  <option timestep=\"" << settings.dt << "\" gravity=\"" << vec(settings.gravity)
+    << "\" integrator=\"Euler\"/>\n"
+    << "  <default><geom condim=\"1\"";
+  if (config.stiff) x << " solref=\"0 " << -1.0 / settings.dt << "\" solimp=\"0.9999 0.9999 0.001 0.5 2\"";
+  x << "/></default>\n  <worldbody>\n";
+  const double radius = sphere_radius(scene);
+  const Plane& plane = std::get<Plane>(scene.bodies.back().shape);
+  // MuJoCo's plane is the solid below local z = 0: zaxis = n, through the point offset·n.
+  x << "    <geom name=\"fixed\" type=\"plane\" size=\"0 0 1\" pos=\"" << vec(plane.offset * plane.normal)
+    << "\" zaxis=\"" << vec(plane.normal) << "\"/>\n";
+  for (const RigidBody& b : scene.bodies) {
+    if (b.fixed) continue;
+    x << "    <body pos=\"" << vec(b.position) << "\"><freejoint/><geom type=\"sphere\" size=\"" << radius
+      << "\" mass=\"" << b.mass << "\"/></body>\n";
+  }
+  x << "  </worldbody>\n</mujoco>\n";
+  return x.str();
+}
+
+mjModel* load_model(const std::string& xml) {
+  mjVFS vfs;
+  mj_defaultVFS(&vfs);
+  const char* name = "peers.xml";
+  if (mj_makeEmptyFileVFS(&vfs, name, static_cast<int>(xml.size())) != 0) throw std::runtime_error("MuJoCo VFS full");
+  const int file = mj_findFileVFS(&vfs, name);
+  std::copy(xml.begin(), xml.end(), static_cast<char*>(vfs.filedata[file]));
+  char error[1000] = "";
+  mjModel* model = mj_loadXML(name, &vfs, error, sizeof error);
+  mj_deleteVFS(&vfs);
+  if (!model) throw std::runtime_error(std::string("MuJoCo: ") + error);
+  return model;
+}
+
+class MujocoStep final : public PeerStep {
+ public:
+  MujocoStep(const bench::PreparedScene& scene, const StepSettings& settings, const MujocoConfig& config)
+      : scene_(scene), settings_(settings), pairs_(scene.contacts) {
+    mjcb_time = &steady_seconds;
+    model_ = load_model(make_mjcf(scene, settings, config));
+    model_->opt.solver = config.solver;
+    model_->opt.iterations = config.iterations;
+    model_->opt.tolerance = config.tolerance;
+    data_ = mj_makeData(model_);
+    reset();
+  }
+
+  ~MujocoStep() override {
+    mj_deleteData(data_);
+    mj_deleteModel(model_);
+  }
+
+  void reset() override {
+    mj_resetData(model_, data_);  // qpos = the bodies' initial poses, warm start cleared
+    std::size_t k = 0;
+    for (const RigidBody& b : scene_.bodies) {
+      if (b.fixed) continue;
+      // Free joint: linear velocity in the world frame, angular velocity in the body frame (identity here).
+      for (int a = 0; a < 3; ++a) {
+        data_->qvel[6 * k + a] = b.velocity[a];
+        data_->qvel[6 * k + 3 + a] = b.angular_velocity[a];
+      }
+      ++k;
+    }
+  }
+
+  void step() override {
+    const double before = data_->timer[mjTIMER_CONSTRAINT].duration;
+    mj_step(model_, data_);
+    solver_seconds_ += data_->timer[mjTIMER_CONSTRAINT].duration - before;
+    ++steps_;
+  }
+
+  StepResult result() override {
+    StepResult r;
+    std::size_t k = 0;
+    for (const RigidBody& b : scene_.bodies) {
+      if (b.fixed) {
+        r.velocity.push_back(Vec3::Zero());
+        r.angular_velocity.push_back(Vec3::Zero());
+        continue;
+      }
+      const mjtNum* v = data_->qvel + 6 * k++;
+      r.velocity.push_back(Vec3(v[0], v[1], v[2]));
+      r.angular_velocity.push_back(Vec3(v[3], v[4], v[5]));  // body frame = world frame (identity pose)
+    }
+    ContactTally tally(pairs_, scene_.contacts.size(), true);
+    for (int c = 0; c < data_->ncon; ++c) {
+      const mjContact& contact = data_->contact[c];
+      // condim 1: one constraint row, the normal force (N); its impulse over the step is force·dt.
+      tally.add(impetus_body(contact.geom1), impetus_body(contact.geom2),
+                data_->efc_force[contact.efc_address] * settings_.dt);
+    }
+    tally.finish(r);
+    r.iterations = data_->solver_iter;
+    r.failures = data_->warning[mjWARN_CONTACTFULL].number + data_->warning[mjWARN_CNSTRFULL].number;
+    r.solver_seconds = steps_ ? solver_seconds_ / steps_ : kNaN;
+    return r;
+  }
+
+ private:
+  std::size_t impetus_body(int geom) const {
+    const int body = model_->geom_bodyid[geom];
+    return body == 0 ? fixed_body(scene_) : static_cast<std::size_t>(body - 1);
+  }
+
+  const bench::PreparedScene& scene_;
+  StepSettings settings_;
+  PairIndex pairs_;
+  mjModel* model_ = nullptr;
+  mjData* data_ = nullptr;
+  double solver_seconds_ = 0.0;
+  long steps_ = 0;
+};
+
+Method mujoco_method(std::string name, const MujocoConfig& config, std::size_t max_bodies) {
+  Method m;
+  m.name = std::move(name);
+  m.restitution = false;  // no Newton restitution coefficient: bounce only through the soft reference
+  m.max_bodies = max_bodies;
+  m.make = [config](const bench::PreparedScene& scene, const StepSettings& settings) {
+    return std::make_unique<MujocoStep>(scene, settings, config);
+  };
+  return m;
+}
+
+}  // namespace
+
+std::string mujoco_description() { return std::string("MuJoCo ") + mj_versionString() + " (double precision)"; }
+
+void add_mujoco_methods(std::vector<Method>& out) {
+  const std::pair<const char*, int> solvers[] = {{"pgs", mjSOL_PGS}, {"cg", mjSOL_CG}, {"newton", mjSOL_NEWTON}};
+  for (const auto& [name, solver] : solvers) {
+    for (const bool stiff : {false, true}) {
+      MujocoConfig c;
+      c.solver = solver;
+      c.stiff = stiff;
+      out.push_back(mujoco_method(std::string("mujoco_") + name + (stiff ? "_stiff" : ""), c, std::size_t(1) << 40));
+    }
+  }
+}
+
+}  // namespace impetus::peers

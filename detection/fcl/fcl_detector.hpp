@@ -21,7 +21,8 @@ struct FclDetectorSettings {
   /// Bodies within this distance of touching produce contacts, with depth = −gap (m, ≥ 0). It makes
   /// resting and exactly touching bodies robust to rounding; keep it far below the bodies' size.
   double margin = 1e-4;
-  /// Most contacts kept per body pair (1…4), chosen to span the largest area.
+  /// Most contacts kept per body pair (1…4), chosen to span the largest area; 0 keeps every point (no
+  /// reduction: benchmarks/model.cpp measures what the reduction saves).
   int max_contacts_per_pair = 4;
   /// Points of one pair closer than this × the smaller body's bounding radius are merged into the
   /// deeper one (relative, 0 … 0.5).

@@ -226,5 +226,21 @@ TEST(FclManifold, MaxContactsPerPairKeepsTheDeepest) {
   EXPECT_DOUBLE_EQ(one[0].depth, deepest);
 }
 
+TEST(FclManifold, ZeroMaxContactsKeepsTheWholeOctagon) {
+  // A unit box on another turned 45° about z: the faces overlap in a regular octagon. Every corner of
+  // it is a contact point without reduction; the reduction keeps 4 of them.
+  const Mat3 turned = rotation_about(Vec3::UnitZ(), std::numbers::pi / 4);
+  const std::vector<RigidBody> bodies{make_body("low", Box{Vec3(1, 1, 1)}, Vec3::Zero()),
+                                      make_body("high", Box{Vec3(1, 1, 1)}, Vec3(0, 0, 1 - 1e-5), turned)};
+  FclDetectorSettings all;
+  all.max_contacts_per_pair = 0;
+  const auto octagon = detect_once(bodies, all);
+  ASSERT_EQ(octagon.size(), 8u);
+  // Octagon corners of a unit square and its 45° turn lie at distance 0.5 / cos(22.5°) from the axis.
+  for (const Contact& c : octagon)
+    EXPECT_NEAR(c.point.head<2>().norm(), 0.5 / std::cos(std::numbers::pi / 8), 1e-6);
+  EXPECT_EQ(detect_once(bodies).size(), 4u);
+}
+
 }  // namespace
 }  // namespace impetus::test

@@ -1,0 +1,139 @@
+// "Model no more than a scene needs" (shared/DESIGN.md), measured: each lever of the engine switched on
+// and off on the same scene, one whole step (detect + resolve + integrate) per iteration from the same
+// state (restored untimed before each step). Rows: model/<lever>/<on|off>. Counters: bodies,
+// contacts, rows_solved (contacts that entered a system), islands, and the per-stage times.
+//
+// Levers:
+//   fixed_bodies  16 sphere pyramids (K = 6) dropped on a fixed ground plane (on) or on a movable ground
+//                 box of 10⁹ kg (off): the fixed ground never enters a system and keeps the pyramids
+//                 apart as 16 islands; a movable ground joins them into one island. Gravity off (the
+//                 heavy box would fall), the paper's drop velocities.
+//   primitives    the pyramid K = 10 of spheres (on) against the same pyramid of convex icosphere meshes
+//                 (642 vertices, radius 0.5; off): the detector's analytic sphere test against GJK/EPA.
+//                 A 5 mm margin in both rows, so the faceted spheres find the same 145 contacts.
+//   contact_reduction  a tower of 10 boxes, each turned 45° from the one below so that every face
+//                 contact is an octagon, under gravity: at most 4 points per pair (on) or all 8 (off).
+//   islands       the 16 pyramids on the fixed ground solved island by island (on) or as one system
+//                 (off, the ledas option `islands: false`).
+#include "impetus/core/scene.hpp"
+#include "impetus/core/world.hpp"
+#include "impetus/plugins/host.hpp"
+
+#include <benchmark/benchmark.h>
+
+#include <cmath>
+#include <memory>
+#include <sstream>
+#include <string>
+#include <vector>
+
+namespace {
+
+using namespace impetus;
+
+std::string header(const std::string& gravity, const std::string& detector, const std::string& resolver) {
+  return "dt: 0.001\ngravity: " + gravity + "\nmodules:\n  integrator: momentum\n  detector: " + detector +
+         "\n  resolver: " + resolver + "\nbodies:\n";
+}
+
+/// `count` pyramids of K rows in the x–z plane, 4 m apart in y, every sphere moving at (0, 0, −1) m/s;
+/// `shape` is the YAML of each sphere's shape. Overlaps as the pyramid generator's (1e-4 r).
+std::string pyramids(int count, int rows, const std::string& shape) {
+  std::ostringstream out;
+  out.precision(17);
+  const double r = 0.5, s = 2 * r * (1 - 1e-4);
+  for (int p = 0; p < count; ++p)
+    for (int j = 0; j < rows; ++j)
+      for (int i = 0; i < rows - j; ++i)
+        out << "  - {name: p" << p << "_" << j << "_" << i << ", shape: " << shape << ", mass: 1, position: ["
+            << (0.5 * j + i) * s << ", " << 4.0 * p << ", " << r * (1 - 1e-4) + j * std::sqrt(3.0) / 2 * s
+            << "], velocity: [0, 0, -1]}\n";
+  return out.str();
+}
+
+const std::string fixed_ground = "  - {name: ground, fixed: true, shape: {plane: {normal: [0, 0, 1], offset: 0}}}\n";
+
+std::string scene_text(const std::string& lever, bool on) {
+  if (lever == "fixed_bodies" || lever == "islands") {
+    const std::string resolver = lever == "islands" && !on ? "{plugin: ledas, islands: false}" : "ledas";
+    const std::string ground =
+        lever == "fixed_bodies" && !on
+            ? "  - {name: ground, shape: {box: {size: [200, 200, 1]}}, mass: 1.0e9, position: [0, 30, -0.49995]}\n"
+            : fixed_ground;
+    return header("[0, 0, 0]", "{plugin: fcl, margin: 1.0e-4}", resolver) + ground +
+           pyramids(16, 6, "{sphere: {radius: 0.5}}");
+  }
+  if (lever == "primitives") {
+    const std::string shape = on ? "{sphere: {radius: 0.5}}" : "{mesh: {file: icosphere_3.obj, scale: 0.5}}";
+    // The icosphere's facets lie up to 2.4 mm inside the sphere: a 5 mm margin finds all 145 contacts
+    // with either shape.
+    return header("[0, 0, -9.81]", "{plugin: fcl, margin: 5.0e-3}", "ledas") + fixed_ground + pyramids(1, 10, shape);
+  }
+  // contact_reduction
+  std::ostringstream out;
+  out.precision(17);
+  out << header("[0, 0, -9.81]", std::string("{plugin: fcl, margin: 1.0e-3, max_contacts_per_pair: ") +
+                                     (on ? "4" : "0") + "}", "ledas")
+      << fixed_ground;
+  for (int level = 0; level < 10; ++level) {
+    const double half = 0.5 * std::atan(1.0) * (level % 2);  // 0 or 22.5°: boxes alternate by 45°
+    out << "  - {name: box" << level << ", shape: {box: {size: [1, 1, 1]}}, mass: 1, position: [0, 0, "
+        << 0.49999 + 0.99999 * level << "], orientation: [" << std::cos(half) << ", 0, 0, " << std::sin(half) << "]}\n";
+  }
+  return out.str();
+}
+
+void model(benchmark::State& state, const std::string& lever, bool on) {
+  PluginHost host;
+  std::unique_ptr<World> world;
+  try {
+    const Scene scene = load_scene_text(scene_text(lever, on), "model_" + lever + ".yaml", IMPETUS_MESH_DIR);
+    world = build_world(scene, host);
+  } catch (const std::exception& e) {
+    state.SkipWithError(e.what());
+    return;
+  }
+  const std::vector<RigidBody> initial(world->bodies().begin(), world->bodies().end());
+  StepProfile sum;
+  StepStatus last;
+  for (auto _ : state) {
+    state.PauseTiming();
+    std::span<RigidBody> bodies = world->bodies();
+    for (std::size_t i = 0; i < bodies.size(); ++i) {
+      bodies[i].position = initial[i].position;
+      bodies[i].rotation = initial[i].rotation;
+      bodies[i].velocity = initial[i].velocity;
+      bodies[i].angular_velocity = initial[i].angular_velocity;
+    }
+    state.ResumeTiming();
+    const StepStatus& s = world->step();
+    state.PauseTiming();
+    sum.detect += s.profile.detect;
+    sum.resolve += s.profile.resolve;
+    sum.total += s.profile.total;
+    last = s;
+    state.ResumeTiming();
+  }
+  const auto per_step = benchmark::Counter::kAvgIterations;
+  state.counters["bodies"] = static_cast<double>(initial.size());
+  state.counters["contacts"] = static_cast<double>(last.detector.contacts);
+  state.counters["rows_solved"] = static_cast<double>(last.resolver.contacts);
+  state.counters["islands"] = static_cast<double>(last.resolver.islands);
+  state.counters["residual"] = last.resolver.residual;
+  state.counters["detect_ms"] = benchmark::Counter(1e3 * sum.detect, per_step);
+  state.counters["resolve_ms"] = benchmark::Counter(1e3 * sum.resolve, per_step);
+}
+
+int register_all() {
+  for (const std::string lever : {"fixed_bodies", "islands", "primitives", "contact_reduction"})
+    for (const bool on : {true, false})
+      benchmark::RegisterBenchmark(("model/" + lever + (on ? "/on" : "/off")).c_str(),
+                                   [lever, on](benchmark::State& st) { model(st, lever, on); })
+          ->Unit(benchmark::kMillisecond);
+  return 0;
+}
+const int registered = register_all();
+
+}  // namespace
+
+BENCHMARK_MAIN();
