@@ -76,8 +76,8 @@ void line(benchmark::State& state) {
 }
 void resting_boxes(benchmark::State& state) { run(state, box_towers(static_cast<int>(state.range(0)) / 10)); }
 
-BENCHMARK(pyramid)->Name("detect/pyramid")->Arg(3)->Arg(4)->Arg(10)->Arg(20)->Unit(benchmark::kMicrosecond);
-BENCHMARK(line)->Name("detect/line")->Arg(10)->Arg(100)->Arg(1000)->Unit(benchmark::kMicrosecond);
+BENCHMARK(pyramid)->Name("detect/pyramid")->Arg(3)->Arg(4)->Arg(10)->Arg(20)->Arg(50)->Arg(100)->Unit(benchmark::kMicrosecond);
+BENCHMARK(line)->Name("detect/line")->Arg(10)->Arg(100)->Arg(1000)->Arg(10000)->Unit(benchmark::kMicrosecond);
 BENCHMARK(resting_boxes)->Name("detect/resting_boxes")->Arg(1000)->Arg(10000)->Unit(benchmark::kMillisecond);
 
 }  // namespace
