@@ -32,7 +32,11 @@ run resolve
 run step
 run detect
 run model
-if [ -x "$build/bin/bench_peers" ]; then run peers; else rm -f "$data/peers.json"; echo "== bench_peers not built (no Bullet/ODE/MuJoCo): skipped"; fi
+if [ -x "$build/bin/bench_peers" ]; then
+  run peers
+  mkdir -p "$root/docs/charts"
+  "$py" "$root/benchmarks/peers/report.py" "$data/peers.json" --chart "$root/docs/charts/peers.png" > "$root/docs/peers.md"
+else rm -f "$data/peers.json"; echo "== bench_peers not built (no Bullet/ODE/MuJoCo): skipped"; fi
 "$py" "$root/scripts/bench_report.py" "$data" "$root/docs"
 
 if [ -x "$build/bin/bench_accuracy" ]; then

@@ -45,6 +45,8 @@ struct BulletConfig {
   bool mlcp = false;          ///< btMLCPSolver + btDantzigSolver, else sequential impulse
   int iterations = 10;        ///< SI iterations (also the MLCP's fallback)
   double global_cfm = 0.0;    ///< regularization: Bullet adds cfm/dt to the MLCP's diagonal
+  double erp = 0.0;           ///< contact ERP (Baumgarte velocity erp·depth/dt), split impulse off
+  bool shipped = false;       ///< leave btContactSolverInfo as shipped (erp 0.2, split impulse on) but iterations
 };
 
 class BulletStep final : public PeerStep {
@@ -63,11 +65,14 @@ class BulletStep final : public PeerStep {
     world_->setGravity(to_bt(settings.gravity));
     btContactSolverInfo& info = world_->getSolverInfo();
     info.m_numIterations = config.iterations;
-    info.m_erp = 0.0;
-    info.m_erp2 = 0.0;
-    info.m_frictionERP = 0.0;
-    info.m_splitImpulse = 0;
-    info.m_globalCfm = config.global_cfm;
+    if (!config.shipped) {
+      // With split impulse off, Bullet uses m_erp for contacts (m_erp2 only with split impulse on).
+      info.m_erp = config.erp;
+      info.m_erp2 = config.erp;
+      info.m_frictionERP = 0.0;
+      info.m_splitImpulse = 0;
+      info.m_globalCfm = config.global_cfm;
+    }
     add_bodies();
   }
 
@@ -203,8 +208,16 @@ void add_bullet_methods(std::vector<Method>& out) {
   BulletConfig mlcp;
   mlcp.mlcp = true;
   out.push_back(bullet_method("bullet_mlcp", mlcp, 1000));
-  mlcp.global_cfm = 1e-8;
+  mlcp.global_cfm = 1e-8;  // regularized
   out.push_back(bullet_method("bullet_mlcp_cfm", mlcp, 1000));
+  // CFM does not help a contact touching with exactly zero normal velocity (the Dantzig ratio test meets
+  // w = 0 and stops at step s = 0): a tiny ERP makes every right-hand side nonzero, at ~1e-7 m/s cost.
+  mlcp.erp = 1e-6;
+  mlcp.global_cfm = 1e-10;  // as ODE's default
+  out.push_back(bullet_method("bullet_mlcp_perturbed", mlcp, 1000));
+  mlcp.erp = 0.0;
+  mlcp.shipped = true;
+  out.push_back(bullet_method("bullet_mlcp_shipped", mlcp, 1000));
 }
 
 }  // namespace impetus::peers

@@ -1,0 +1,95 @@
+#!/usr/bin/env python3
+"""Table (markdown) and chart (time per solve against error) from a bench_peers JSON run.
+
+    bench_peers --benchmark_repetitions=3 --benchmark_report_aggregates_only=true \
+                --benchmark_format=json > peers.json
+    benchmarks/peers/report.py peers.json [--chart peers.png]
+
+Times are medians over the repetitions: CPU time of the process (robust on a shared machine) and wall
+time; the counters are those of the median aggregate (they do not vary between repetitions).
+"""
+import argparse
+import json
+import math
+import sys
+
+
+def load(path):
+    with open(path) as f:
+        data = json.load(f)
+    rows = {}
+    for b in data["benchmarks"]:
+        if b.get("aggregate_name") != "median" or b.get("error_occurred"):
+            continue
+        _, method, scene = b["run_name"].split("/")[:3]
+        rows[(method, scene)] = b
+    return rows
+
+
+def fmt(x):
+    if x is None or (isinstance(x, float) and math.isnan(x)):
+        return "nan"
+    if x == 0:
+        return "0"
+    return f"{x:.3g}" if 1e-3 <= abs(x) < 1e4 else f"{x:.1e}"
+
+
+def table(rows):
+    scenes = sorted({s for _, s in rows}, key=lambda s: (s.split("_")[0], int(s.split("_")[1]), s))
+    out = ["| method | scene | contacts (engine) | cpu ms | wall ms | solver ms | residual m/s | complementarity | energy change | failures | exact |",
+           "|---|---|---|---|---|---|---|---|---|---|---|"]
+    for method in dict.fromkeys(m for m, _ in rows):
+        for scene in scenes:
+            b = rows.get((method, scene))
+            if not b:
+                continue
+            out.append("| {} | {} | {} ({}) | {} | {} | {} | {} | {} | {} | {} | {} |".format(
+                method, scene, int(b["contacts"]), int(b["engine_contacts"]), fmt(b["cpu_time"]),
+                fmt(b["real_time"]), fmt(b.get("solver_ms")), fmt(b["residual"]), fmt(b["complementarity"]),
+                fmt(b["energy_change"]), int(b["failures"]), int(b["exact"])))
+    return "\n".join(out)
+
+
+def chart(rows, path, scene):
+    try:
+        import matplotlib
+    except ImportError:
+        sys.exit("--chart needs matplotlib (Debian: python3-matplotlib; run with /usr/bin/python3)")
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    fig, ax = plt.subplots(figsize=(9, 6))
+    for (method, s), b in rows.items():
+        if s != scene or method.endswith("_gravity"):
+            continue
+        # One error axis: a method that leaves no approach but pushes the bodies apart (Baumgarte) is not
+        # exact either, so the larger of residual and complementarity is drawn; exact zero at the floor.
+        error = max(b["residual"], 0 if math.isnan(b["complementarity"]) else b["complementarity"], 1e-17)
+        ax.scatter(b["cpu_time"], error)
+        ax.annotate(method, (b["cpu_time"], error), fontsize=7)
+    ax.set_xscale("log")
+    ax.set_yscale("log")
+    ax.set_xlabel("CPU time per step (engines) or solve (Impetus), ms, median")
+    ax.set_ylabel("max(residual m/s, complementarity N·m/s) after")
+    ax.set_title(f"bench_peers, {scene}")
+    ax.axhline(1e-9, color="grey", linestyle=":", linewidth=1)
+    fig.tight_layout()
+    fig.savefig(path, dpi=120)
+
+
+def main():
+    p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    p.add_argument("json")
+    p.add_argument("--chart", help="write a PNG: CPU time against residual")
+    p.add_argument("--scene", default="pyramid_20", help="scene for the chart (default pyramid_20)")
+    args = p.parse_args()
+    rows = load(args.json)
+    if not rows:
+        sys.exit(f"{args.json}: no median aggregates (run with --benchmark_repetitions=3 "
+                 "--benchmark_report_aggregates_only=true)")
+    print(table(rows))
+    if args.chart:
+        chart(rows, args.chart, args.scene)
+
+
+if __name__ == "__main__":
+    main()
