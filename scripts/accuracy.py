@@ -1,0 +1,487 @@
+#!/usr/bin/env python3
+"""The stability atlas and the accuracy charts from one run of the accuracy suite.
+
+    python3 scripts/accuracy.py SUITE.json DOCS_DIR
+
+reads the JSON written by `bench_accuracy --out SUITE.json` (benchmarks/accuracy/README.md) and writes
+  DOCS_DIR/stability.md                        the atlas: scenario x method, pass/fail with its figure,
+                                               and why the failing methods fail
+  DOCS_DIR/charts/accuracy_<group>.png/.svg    per scenario: time per step (x, log) against error
+                                               (y, log), one point per method x setting, Pareto front
+  DOCS_DIR/charts/accuracy_overview.png/.svg   the headline chart (six scenarios)
+Needs matplotlib (Debian: python3-matplotlib); if the python3 on PATH lacks it, the script re-runs itself
+with /usr/bin/python3.
+"""
+import json
+import math
+import os
+import sys
+
+try:
+    import matplotlib
+except ImportError:  # e.g. a pyenv python3 first on PATH: use the system one, which has the package
+    if os.path.exists("/usr/bin/python3") and os.path.realpath(sys.executable) != "/usr/bin/python3":
+        os.execv("/usr/bin/python3", ["/usr/bin/python3"] + sys.argv)
+    sys.exit("accuracy.py: matplotlib is missing (apt-get install python3-matplotlib)")
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+from matplotlib import ticker  # noqa: E402
+
+RESOLVERS = ["ledas/complementary", "ledas/paper", "mirtich"]
+INTEGRATORS = ["euler", "momentum"]
+COLUMNS = [("ledas/complementary", None), ("ledas/paper", None), ("mirtich", None),
+           (None, "euler"), (None, "momentum")]
+COLUMN_TITLES = ["ledas complementary", "ledas paper", "mirtich (sequential)", "euler (paper's eq. 2)",
+                 "momentum"]
+COLORS = {"ledas/complementary": "#1f77b4", "ledas/paper": "#ff7f0e", "mirtich": "#2ca02c"}
+MARKERS = {"momentum": "o", "euler": "s"}
+FLOOR = 1e-17  # an error of exactly 0 is plotted here
+OVERVIEW = ["billiards", "cradle_20", "pyramid_drop_20", "box_stack_20", "pendulum_velocity", "t_handle"]
+
+# Why a method fails a scenario: printed under the scenario only when that method fails it there.
+WHY = {
+    ("billiards", "mirtich"):
+        "The sequential method resolves one contact at a time. Ball 1 touches balls 2 and 3 "
+        "symmetrically, but the sweep picks one contact first (the most approaching, ties to the lower "
+        "index), so ball 2 takes a full elastic impulse before ball 3 is touched: the outcome depends on "
+        "the order, not on the physics (paper, sec. 1). Momentum and energy are still conserved.",
+    ("cradle", "ledas/complementary"):
+        "Resolving every contact at once is one simultaneous impact of the whole chain: the inelastic "
+        "solve gives every ball the common velocity 1/N and restitution doubles the impulse, so ball 1 "
+        "rebounds at 2/N - 1 and the others leave together at 2/N. Momentum and energy are conserved, "
+        "but it is not the classic cradle, which is a sequence of two-ball collisions (the paper's "
+        "round-by-round mode and the sequential method give it).",
+    ("pyramid_drop", "mirtich"):
+        "An inelastic pyramid is a chain of coupled contacts; single impulses converge like Gauss-Seidel "
+        "on it, so the number needed grows quickly with K and the sweep stops at its cap "
+        "(`max_impulses`, default max(10 000, 100 x contacts)) with contacts still approaching.",
+    ("pyramid_drop", "ledas/paper"):
+        "The paper's round-by-round mode only lets approaching contacts in: spheres that move together "
+        "do not approach, so the impulse travels down the pyramid one layer per round. With a small "
+        "`max_rounds` it stops before the last layer has been reached.",
+    ("pyramid_drop", "ledas/complementary"):
+        "Capping the active-set iterations (`max_rounds`) stops the exact solve before every contact's "
+        "sign is settled.",
+    ("figure2", "mirtich"):
+        "The four corner contacts of the flat face are redundant (the matrix A has rank 3). The "
+        "sequential sweep spreads the impulse by the order in which it meets the corners, not by any "
+        "principle, so the impulses are far from the minimum-norm ones, although the plank does stop.",
+    ("pyramid_walls", "*"):
+        "The walls squeeze the bottom row, so the contact set is singular and its position-correction "
+        "targets can conflict; a solver that cycles there runs each step to its cap `max_rounds` (10^6 "
+        "singular solves: minutes per step, seen during development of both ledas modes: `impetus run "
+        "assets/scenes/accuracy_pyramid_walls.yaml --steps 240`, and `--steps 5 --set "
+        "modules.resolver.mode=paper`). With a small cap the steps end but the pyramid creeps.",
+    ("resting", "mirtich"):
+        "Sequential impulses on many coupled resting contacts need many sweeps every step; the order of "
+        "single impulses leaves small spins and sideways velocities that the frictionless contacts never "
+        "remove, so the bodies creep and keep jittering.",
+    ("resting", "ledas/paper"):
+        "In the paper's mode contacts enter round by round: resting bodies all move down together under "
+        "gravity, so only the bottom contacts approach at first and every step takes one round per layer, "
+        "each a (singular, minimum-norm) solve. Pulling impulses are applied as the paper does.",
+    ("resting", "euler"):
+        "The resting scenes barely rotate, so the integrator is rarely the cause; see the resolver column.",
+    ("box_stack", "mirtich"):
+        "Every step the sweep hits its cap of single impulses (the stack is a long chain of coupled "
+        "contacts) and leaves some approach, plus small spins from the order of the impulses; without "
+        "friction nothing removes them and the stack slides apart or sinks.",
+    ("box_stack", "ledas/paper"):
+        "The paper's mode takes one round per layer of the stack in every step (the bodies above the "
+        "lowest approaching contact move together and do not approach), each a minimum-norm solve of a "
+        "singular system: the run is too slow to finish within its budget, and with a cap it stops early.",
+    ("mass_ratio", "mirtich"):
+        "Two coupled contacts under a heavy box converge by the factor m_top / (m_top + m_bottom) per "
+        "sweep (100/101, 1000/1001): the sweep stops at its cap long before the contacts are resolved.",
+    ("mass_ratio", "ledas/paper"):
+        "Round by round, the heavy box's contact only enters after the lower one has been resolved; "
+        "pulling impulses and the rounds cap leave the pair unresolved.",
+    ("pendulum", "mirtich"):
+        "The sequential baseline has no joints: it refuses constraints (the world is not built).",
+    ("pendulum_velocity", "*"):
+        "At velocity level a joint only zeroes the relative velocity of the joined points; the rotation "
+        "step is not linear in the angular velocity, so each step leaves a small separation that nothing "
+        "removes: the gap grows steadily, the more so the larger the step (paper, sec. 4). The position "
+        "level asks for the points to coincide after the step and does not drift.",
+    ("t_handle", "euler"):
+        "The paper's eq. 2 updates the angular velocity from the torque and otherwise keeps it constant in "
+        "the world frame: the gyroscopic term is missing, so a torque-free body spinning about anything "
+        "but a principal axis turns steadily about a fixed axis instead of tumbling, and its angular "
+        "momentum vector drifts by a fixed amount that no step size removes.",
+    ("t_handle", "momentum"):
+        "The `momentum` integrator keeps L exactly but its explicit rotation step lets the kinetic energy "
+        "grow at first order in dt; at coarse steps the growth exceeds the bound.",
+    ("bracket", "*"):
+        "Energy rises when the position correction lifts a penetrating body (it adds potential energy, "
+        "not kinetic) or when a coarse step lets the mesh sink deep before the contact is found.",
+}
+
+# Why a method that passes at the reference step fails at other swept steps (printed when it does).
+DT_NOTES = {
+    "bracket_bounce":
+        "At coarse steps (1/100 s and above) the bracket falls centimetres into the ground between two "
+        "detections (the detector's margin is 1 mm, so the landing is not caught ahead); the position "
+        "correction then lifts it out, which adds potential energy: the total energy rises by up to a few "
+        "per cent. Every method does this; it is the step, not the resolver.",
+    "t_handle":
+        "`momentum` conserves L at every step but its kinetic energy grows at first order in dt while the "
+        "handle flips: +3 % over 20 s at 1/1000 s, tens of per cent at 1/250 s and more than doubled at "
+        "1/30 s. An energy-conserving rotation step would need an implicit (midpoint) update.",
+    "box_stack_settle":
+        "At 1/30 s the boxes land 6 cm deep (v dt past the 1 mm margin) and the correction pushes them "
+        "apart over several steps; the top box ends 2 mm off. The sequential method drifts at every "
+        "step size (table above), most at the coarsest and the finest steps.",
+    "pyramid_walls":
+        "The sequential method jitters at every step size: its rest kinetic energy never falls below "
+        "the bound.",
+}
+
+
+def md(text):
+    """Text safe inside a Markdown table cell."""
+    return text.replace("|", "\\|")
+
+
+def fmt(x):
+    if x is None:
+        return "-"
+    if x == 0:
+        return "0"
+    if isinstance(x, float) and (math.isnan(x) or math.isinf(x)):
+        return str(x)
+    return "%.2g" % x
+
+
+def fmt_time(t):
+    if t is None or t <= 0:
+        return "-"
+    for unit, scale in (("s", 1.0), ("ms", 1e-3), ("µs", 1e-6)):
+        if t >= scale:
+            return "%.3g %s" % (t / scale, unit)
+    return "%.3g ns" % (t / 1e-9)
+
+
+def default_run(scenario, method, integrator):
+    """The run the atlas judges: the method at the reference step, default caps."""
+    for r in scenario["runs"]:
+        if r["method"] != method or r["integrator"] != integrator or r["cap"] is not None:
+            continue
+        if scenario["kind"] == "simulation" and not math.isclose(r["dt"], scenario["reference_dt"]):
+            continue
+        return r
+    return None
+
+
+def failing_measures(scenario, run):
+    bounds = scenario["bounds"]
+    return [k for k, b in bounds.items() if run["errors"].get(k) is None or not run["errors"][k] <= b]
+
+
+def dt_summary(scenario, method, integrator):
+    """Which steps the method passes at (default caps), e.g. 'dt <= 1/120'."""
+    if scenario["kind"] != "simulation":
+        return ""
+    runs = [r for r in scenario["runs"] if r["method"] == method and r["integrator"] == integrator
+            and r["cap"] is None and r["status"] != "unsupported"]
+    if len(runs) < 2:
+        return ""
+    runs.sort(key=lambda r: -r["dt"])
+    passing = [r for r in runs if r["pass"]]
+    if len(passing) == len(runs):
+        return "every dt"
+    if not passing:
+        return "no dt"
+    largest = max(passing, key=lambda r: r["dt"])
+    if all(r["pass"] for r in runs if r["dt"] <= largest["dt"]):
+        return "dt ≤ " + largest["dt_label"]
+    return "dt " + ", ".join(r["dt_label"] for r in passing)
+
+
+def cell(scenario, method, integrator):
+    run = default_run(scenario, method, integrator)
+    if run is None:
+        return "—"
+    if run["status"] == "unsupported":
+        return "n/a (unsupported)"
+    if run["status"] in ("error", "hung"):
+        return "⚠ %s" % run["status"]
+    primary = scenario["primary"]
+    if run["pass"]:
+        text = "✅ %s" % fmt(run["errors"].get(primary))
+    else:
+        bad = failing_measures(scenario, run)
+        shown = primary if primary in bad or not bad else bad[0]
+        label = "" if shown == primary else shown.replace("_", " ") + " "
+        mark = "⏱" if run["status"] == "budget" else "❌"
+        text = "%s %s%s" % (mark, label, fmt(run["errors"].get(shown)))
+        if run["status"] == "budget":
+            text += " (stopped at %.3g s)" % run["simulated_s"]
+    hits = run["counters"]["non_converged"]
+    if hits and scenario["kind"] == "simulation":
+        text += " · cap hit in %d of %d steps" % (hits, run["steps"]) if hits <= run["steps"] else \
+            " · cap hit %d times" % hits
+    elif hits:
+        text += " · cap hit"
+    summary = dt_summary(scenario, method, integrator)
+    return text + (" · " + summary if summary else "")
+
+
+def column_run(scenario, column):
+    method, integrator = column
+    if method is None:  # an integrator column: judged with the reference resolver
+        if scenario["kind"] == "impact":
+            return None, None
+        method = scenario["resolvers"][0]
+    return method, integrator or "momentum"
+
+
+def atlas(suite):
+    lines = []
+    out = lines.append
+    out("# Stability atlas")
+    out("")
+    out("Generated by `scripts/accuracy.py` from one run of the accuracy suite (`bench_accuracy%s`, %s, "
+        "%s build, %d cores; every run's data in `docs/data/accuracy.json`). Do not edit by hand: "
+        "`bench_accuracy --out docs/data/accuracy.json && python3 scripts/accuracy.py "
+        "docs/data/accuracy.json docs`." % (" --quick" if suite["quick"] else "", suite["generated_utc"][:10],
+                                            suite["build_type"], suite["cores"]))
+    out("")
+    out("Each cell judges one method against the scenario's criterion (below the table) at the scenario's "
+        "reference setting: the resolver columns with the `momentum` integrator, the integrator columns "
+        "with `ledas` (complementary), both at the reference time step and default iteration caps. The "
+        "figure is the scenario's main error (or the measure that failed). For simulations, `· dt ≤ …` says "
+        "at which of the swept time steps the method passes. ✅ pass, ❌ fail, ⏱ stopped at the wall-time "
+        "budget of %g s per run (too slow; the figure is over the part simulated), ⚠ the run failed, — "
+        "not applicable (an impact is one resolution: no integrator, no time step). The charts "
+        "(`docs/charts/accuracy_*.svg`) show every setting: time per step against error, Pareto front "
+        "marked." % suite["budget_s"])
+    out("")
+    out("| scenario | criterion | " + " | ".join(COLUMN_TITLES) + " |")
+    out("|---|---|" + "---|" * len(COLUMNS))
+    for s in suite["scenarios"]:
+        cells = []
+        for column in COLUMNS:
+            method, integrator = column_run(s, column)
+            cells.append("—" if method is None or method not in s["resolvers"] else cell(s, method, integrator))
+        ref = " (dt %s)" % s["reference_dt_label"] if s["kind"] == "simulation" else ""
+        out("| [%s](#%s)%s | %s | %s |" % (s["title"], s["id"].replace(".", ""), ref, md(s["criterion"]),
+                                           " | ".join(cells)))
+    out("")
+    groups = []
+    for s in suite["scenarios"]:
+        if s["group"] not in groups:
+            groups.append(s["group"])
+    for s in suite["scenarios"]:
+        out("## %s" % s["id"])
+        out("")
+        out("**%s.** Scene `%s`%s. Measures: %s. Criterion: %s. Chart: "
+            "[`accuracy_%s.svg`](charts/accuracy_%s.svg)." % (
+                s["title"], s["scene"],
+                (" with `--set " + "`, `--set ".join(s["overrides"]) + "`") if s["overrides"] else "",
+                s["measures"], md(s["criterion"]), s["group"], s["group"]))
+        out("")
+        errors = list(s["errors"].keys())
+        out("| method | integrator | dt | cap | status | time/step | rounds/step (max) | cap hits | "
+            + " | ".join(errors) + " | pass |")
+        out("|---|---|---|---|---|---|---|---|" + "---|" * len(errors) + "---|")
+        unsupported = set()
+        for r in s["runs"]:
+            if r["status"] == "unsupported":  # one row says it; the method refuses the scene at any setting
+                if r["method"] in unsupported:
+                    continue
+                unsupported.add(r["method"])
+                out("| %s | any | any | any | unsupported: %s |%s" % (
+                    r["method"], md(r["message"].split(": ")[-1]), " |" * (4 + len(errors))))
+                continue
+            cap = "%s=%d" % (r["cap_option"], r["cap"]) if r["cap"] else "default"
+            out("| %s | %s | %s | %s | %s | %s | %s | %s | %s | %s |" % (
+                r["method"], r["integrator"] if s["kind"] == "simulation" else "—", r["dt_label"] or "—", cap,
+                r["status"], fmt_time(r["time_per_step_s"]), r["counters"]["max_rounds_per_step"],
+                r["counters"]["non_converged"], " | ".join(fmt(r["errors"].get(e)) for e in errors), "✅" if r["pass"] else "❌"))
+        out("")
+        failing = failing_columns(s)
+        if failing:
+            out("**Why the failing methods fail.**")
+            out("")
+            for name, note in failing:
+                text = WHY.get((s["id"], name)) or WHY.get((s["group"], name)) or WHY.get((s["id"], "*")) \
+                    or WHY.get((s["group"], "*"))
+                out("- *%s*%s: %s" % (name, note, text or "no explanation recorded yet; see the table above."))
+            out("")
+        else:
+            out("Every method passes at its reference setting.")
+            out("")
+        off_reference = [r for r in s["runs"] if s["kind"] == "simulation" and r["cap"] is None and not r["pass"]
+                         and r["status"] == "ok" and not math.isclose(r["dt"], s["reference_dt"])]
+        if off_reference and s["id"] in DT_NOTES:
+            out("**At other time steps** (%s fail): %s" % (
+                ", ".join(sorted({"%s %s at %s" % (r["method"], r["integrator"], r["dt_label"])
+                                  for r in off_reference})), DT_NOTES[s["id"]]))
+            out("")
+    return "\n".join(lines) + "\n"
+
+
+def failing_columns(s):
+    """(name, note) for each column whose method fails here: at its reference setting, or only with a cap."""
+    out = []
+    for column in COLUMNS:
+        method, integrator = column_run(s, column)
+        if method is None or method not in s["resolvers"]:
+            continue
+        name = column[0] or column[1]
+        if any(n == name for n, _ in out):
+            continue
+        run = default_run(s, method, integrator)
+        if run is not None and run["status"] != "unsupported" and not run["pass"]:
+            out.append((name, ""))
+        elif run is not None and run["status"] == "unsupported":
+            out.append((name, " (unsupported)"))
+        elif column[0]:
+            capped = sorted({r["cap"] for r in s["runs"] if r["method"] == method and r["cap"] and not r["pass"]})
+            if capped:
+                option = next(r["cap_option"] for r in s["runs"] if r["method"] == method)
+                out.append((name, " (only with a cap: %s = %s)" % (option, ", ".join(str(c) for c in capped))))
+    return out
+
+
+def pareto(points):
+    """Indices of the points no other point beats in both time and error."""
+    front = []
+    best = math.inf
+    for i in sorted(range(len(points)), key=lambda i: (points[i][0], points[i][1])):
+        if points[i][1] < best:
+            front.append(i)
+            best = points[i][1]
+    return front
+
+
+def plot_scenario(ax, s, compact=False):
+    xs, ys = [], []
+    for r in s["runs"]:
+        if r["status"] not in ("ok", "budget") or not r["time_per_step_s"]:
+            continue
+        y = r["errors"].get(s["primary"])
+        if y is None:
+            continue
+        x, y = r["time_per_step_s"], max(y, FLOOR)
+        xs.append(x)
+        ys.append(y)
+        filled = r["cap"] is None and r["status"] == "ok"
+        color = COLORS.get(r["method"], "gray")
+        ax.scatter([x], [y], marker=MARKERS.get(r["integrator"], "o"), s=30 if compact else 40,
+                   facecolors=color if filled else "none", edgecolors=color, linewidths=1.2, zorder=3)
+        if not compact and (r["dt_label"] or r["cap"]):
+            label = r["dt_label"] + (" cap %d" % r["cap"] if r["cap"] else "")
+            ax.annotate(label.strip(), (x, y), textcoords="offset points", xytext=(4, 3), fontsize=6,
+                        color="#555555")
+    if xs:
+        front = pareto(list(zip(xs, ys)))
+        fx = [xs[i] for i in front]
+        fy = [ys[i] for i in front]
+        ax.step(fx, fy, where="post", color="black", linewidth=0.9, linestyle="--", zorder=2)
+        ax.scatter(fx, fy, s=110 if not compact else 80, facecolors="none", edgecolors="black",
+                   linewidths=0.8, zorder=4)
+    bound = s["bounds"].get(s["primary"])
+    if bound:
+        ax.axhline(bound, color="#d62728", linewidth=0.8, linestyle=":", zorder=1)
+    if any(y <= FLOOR for y in ys):
+        ax.axhline(FLOOR, color="#999999", linewidth=0.6, linestyle="-.", zorder=1)
+    ax.set_xscale("log")
+    ax.set_yscale("log")
+    if xs:
+        widen(ax.set_xlim, min(xs) / 1.5, max(xs) * 1.5, 10)
+        levels = ys + ([bound] if bound else [])
+        widen(ax.set_ylim, min(levels) / 10, max(levels) * 10, 1e3)
+    for axis in (ax.xaxis, ax.yaxis):
+        axis.set_major_locator(ticker.LogLocator(base=10, numticks=8))
+        axis.set_minor_locator(ticker.LogLocator(base=10, subs=(2, 5), numticks=8))
+        axis.set_minor_formatter(ticker.NullFormatter())
+    ax.set_title(s["title"] if not compact else s["id"], fontsize=8 if compact else 9)
+    ax.set_xlabel("wall time per step (s)", fontsize=7 if compact else 8)
+    ax.set_ylabel(s["primary"].replace("_", " "), fontsize=7 if compact else 8)
+    ax.tick_params(labelsize=6 if compact else 7)
+    ax.grid(True, which="major", linewidth=0.3, alpha=0.5)
+
+
+def widen(set_limits, lo, hi, ratio):
+    """Log-axis limits spanning at least `ratio`, centred on the data."""
+    if hi / lo < ratio:
+        mid = math.sqrt(lo * hi)
+        lo, hi = mid / math.sqrt(ratio), mid * math.sqrt(ratio)
+    set_limits(lo, hi)
+
+
+def legend(fig):
+    from matplotlib.lines import Line2D
+    handles = [Line2D([], [], marker="o", linestyle="", color=c, label=m) for m, c in COLORS.items()]
+    handles += [Line2D([], [], marker=MARKERS[i], linestyle="", markerfacecolor="none", color="black",
+                       label="integrator " + i) for i in INTEGRATORS]
+    handles += [Line2D([], [], marker="o", linestyle="", markerfacecolor="none", color="gray",
+                       label="capped / stopped at budget"),
+                Line2D([], [], linestyle="--", color="black", label="Pareto front"),
+                Line2D([], [], linestyle=":", color="#d62728", label="criterion"),
+                Line2D([], [], linestyle="-.", color="#999999", label="error 0 (drawn at 1e-17)")]
+    fig.legend(handles=handles, loc="lower center", ncol=5, fontsize=7, frameon=False)
+
+
+def save(fig, path):
+    fig.savefig(path + ".png", dpi=110, metadata={"Software": None})
+    fig.savefig(path + ".svg", metadata={"Date": None, "Creator": None})
+    plt.close(fig)
+
+
+def charts(suite, chart_dir):
+    os.makedirs(chart_dir, exist_ok=True)
+    groups = {}
+    for s in suite["scenarios"]:
+        groups.setdefault(s["group"], []).append(s)
+    written = []
+    for group, members in groups.items():
+        n = len(members)
+        cols = min(3, n)
+        rows = (n + cols - 1) // cols
+        fig, axes = plt.subplots(rows, cols, figsize=(4.6 * cols, 3.6 * rows + 0.7), squeeze=False)
+        for ax, s in zip(axes.flat, members):
+            plot_scenario(ax, s)
+        for ax in list(axes.flat)[n:]:
+            ax.axis("off")
+        legend(fig)
+        fig.tight_layout(rect=(0, 0.09 if rows == 1 else 0.05, 1, 1))
+        path = os.path.join(chart_dir, "accuracy_" + group)
+        save(fig, path)
+        written.append(path)
+    by_id = {s["id"]: s for s in suite["scenarios"]}
+    chosen = [by_id[i] for i in OVERVIEW if i in by_id]
+    if chosen:
+        fig, axes = plt.subplots(2, 3, figsize=(12, 7.2), squeeze=False)
+        for ax, s in zip(axes.flat, chosen):
+            plot_scenario(ax, s, compact=True)
+        for ax in list(axes.flat)[len(chosen):]:
+            ax.axis("off")
+        fig.suptitle("Impetus: speed against accuracy (time per step vs error, log-log; Pareto front dashed)",
+                     fontsize=10)
+        legend(fig)
+        fig.tight_layout(rect=(0, 0.06, 1, 0.97))
+        path = os.path.join(chart_dir, "accuracy_overview")
+        save(fig, path)
+        written.append(path)
+    return written
+
+
+def main(argv):
+    if len(argv) != 3:
+        sys.exit("usage: accuracy.py SUITE.json DOCS_DIR")
+    with open(argv[1]) as f:
+        suite = json.load(f)
+    plt.rcParams["svg.hashsalt"] = "impetus-accuracy"
+    docs = argv[2]
+    os.makedirs(docs, exist_ok=True)
+    with open(os.path.join(docs, "stability.md"), "w") as f:
+        f.write(atlas(suite))
+    written = charts(suite, os.path.join(docs, "charts"))
+    print("accuracy.py: wrote %s and %d charts (png + svg) in %s" % (
+        os.path.join(docs, "stability.md"), len(written), os.path.join(docs, "charts")))
+
+
+if __name__ == "__main__":
+    main(sys.argv)
