@@ -4,17 +4,23 @@
 /// problem. Knows nothing of bodies or detectors: a symmetric positive semi-definite matrix A (eq. 7,
 /// A = G M⁻¹ Gᵀ) and a right-hand side come in, impulses come out, so it is tested directly.
 ///
-/// The cheapest exact method per system (shared/DESIGN.md, "Model no more than a scene needs"):
+/// Equalities on a subset (the paper mode's rounds): the subset splits into independent blocks (rows
+/// coupled through a shared movable body), each solved by the cheapest exact method (shared/DESIGN.md,
+/// "Model no more than a scene needs"):
 ///  - one row: closed form p = c / A_11;
 ///  - up to `dense_limit` rows: dense LDLᵀ with diagonal pivoting (rank-revealing for a PSD matrix);
-///  - more rows: sparse LDLᵀ (Eigen SimplicialLDLT, AMD ordering). Its symbolic analysis is cached by
-///    sparsity pattern and reused while the pattern is unchanged (a resting stack step after step).
-///    Inside an active-set loop, a change of at most `update_limit` rows is solved by a Schur-complement
-///    update of the last factorization instead of refactoring;
-///  - a rank-deficient A (a pivot ≤ rank_tolerance · max A_ii: redundant contacts, the paper's
+///  - more rows: sparse LDLᵀ (Eigen SimplicialLDLT, AMD ordering; symbolic analysis cached by pattern);
+///  - a rank-deficient block (a pivot ≤ rank_tolerance · max A_ii: redundant contacts, the paper's
 ///    Figure 2) gets the minimum-norm least-squares solution, as the paper prescribes: dense by the
 ///    eigen-decomposition (the SVD of a symmetric PSD matrix), sparse by projecting out a null-space
-///    basis found by shifted inverse iteration. The rank test decides, never a failed factorization.
+///    basis found by shifted inverse iteration.
+///
+/// Complementarity (the complementary mode, the position correction): a proximal-point iteration whose
+/// subproblems have the positive definite matrix A + εI, each solved by block principal pivoting then
+/// the primal active-set method, on a masked sparse LDLᵀ (masked_ldlt.hpp) with one symbolic analysis
+/// per pattern and Schur-complement updates for small changes; exact to 1e-3 · tolerance on the free
+/// rows. No minimum-norm solve inside the loop (the velocities are unique, the impulses are not); a
+/// minimum-norm polish at the end where the system is small. README.md derives it.
 
 #include <Eigen/Dense>
 #include <Eigen/SparseCholesky>
@@ -27,6 +33,8 @@
 
 namespace impetus::ledas {
 
+class MaskedLdlt;
+
 /// Column-major sparse matrix with both triangles stored (A is symmetric).
 using SparseMatrix = Eigen::SparseMatrix<double>;
 using Vector = Eigen::VectorXd;
@@ -37,8 +45,10 @@ using RowIndex = std::uint32_t;
 struct SolverSettings {
   std::size_t dense_limit = 64;   ///< systems of at most this many rows use the dense path
   double rank_tolerance = 1e-10;  ///< a pivot or eigenvalue ≤ this × max A_ii counts as zero
-  std::size_t update_limit = 16;  ///< sparse path: largest active-set change solved by an update
+  std::size_t update_limit = 8;  ///< sparse path: largest active-set change solved by an update
   std::uint64_t max_iterations = 10000;  ///< active-set iterations per complementarity problem
+  /// Complementarity problems: proximal regularization ε = this × max A_kk (solve_complementarity).
+  double regularization = 1e-10;
 };
 
 /// What the solver did, accumulated over calls (reset by the caller).
@@ -55,6 +65,8 @@ struct SolverStats {
   std::uint64_t added = 0;        ///< rows added because they would have approached
   std::uint64_t non_converged = 0;  ///< complementarity problems that hit max_iterations
   std::uint64_t nan_caught = 0;   ///< systems whose solution was not finite (zero returned)
+  std::uint64_t polished = 0;     ///< complementarity solutions replaced by the minimum-norm split
+  std::uint64_t proximal = 0;     ///< proximal outer iterations after the first
 };
 
 /// One island's complementarity problem: find p with w = A p − c and
@@ -81,12 +93,18 @@ class IslandSolver {
   /// of `a`, zero outside the subset. Minimum-norm least squares when A_SS is rank-deficient.
   Vector solve_subset(const SparseMatrix& a, const Vector& c, std::span<const RowIndex> subset,
                       SolverStats& stats);
+  /// The same into `p` (size a.rows()): writes the subset's entries only, allocates nothing for the
+  /// one- and few-row blocks the paper's rounds are made of.
+  void solve_subset(const SparseMatrix& a, const Vector& c, std::span<const RowIndex> subset, Vector& p,
+                    SolverStats& stats);
 
-  /// Solves the complementarity problem by a primal active-set method started from the given set
-  /// (island_solver.cpp): solve the free rows as equalities; step back from a minimizer with negative
-  /// impulses and release the rows that reach zero; add every row that would approach. The QP objective
-  /// ½ pᵀA p − cᵀp never increases, so it terminates also for singular A. Returns p with p ≥ 0 on
-  /// inequality rows (the last feasible iterate if max_iterations is reached).
+  /// Solves the complementarity problem (island_solver.cpp, README.md): proximal-point outer iterations
+  /// on ½ pᵀ(A + εI) p − (c + ε p̄)ᵀp, ε = regularization · max A_kk, each subproblem by block principal
+  /// pivoting while the number of infeasible rows falls, then the primal active-set method (monotone:
+  /// it terminates), started from the given set. Returns p with p ≥ 0 on inequality rows, w ≥ −tolerance
+  /// and |w| ≤ 1e-3 · tolerance on the rows with p ≠ 0; the minimum-norm split where the final system has
+  /// at most dense_limit rows and that split is ≥ 0. Conflicting targets (no exact solution): the
+  /// minimum-norm least-squares active set of solve_complementarity_min_norm.
   Vector solve_complementarity(const ComplementarityProblem& problem, SolverStats& stats);
 
   const SolverSettings& settings() const { return settings_; }
@@ -95,24 +113,40 @@ class IslandSolver {
   struct Factor;
   using FactorPtr = std::shared_ptr<Factor>;
 
-  struct ActiveBase {  // the last sparse factorization of an active-set loop, for updates
-    FactorPtr factor;
-    std::vector<char> rows;
+  struct ActiveLoop {  // one active-set loop: its masked factorization and the rows it holds
+    std::unique_ptr<MaskedLdlt> factor;
+    bool factored = false;
+    double floor = 0.0;               // A_kk at or below this: nothing movable behind row k
+    bool singular = false;            // a factorization met a redundant row (pivot ≈ the shift)
+    std::vector<char> in_base;        // rows of the last factorization (free and not dropped)
+  };
+  struct Workspace {  // reused buffers (no allocation per round once warm)
+    std::vector<RowIndex> added, removed;  // update path
+    Eigen::MatrixXd columns, borders;
+    std::vector<int> slot, parent, start, fill, members;  // subset components
+    Eigen::MatrixXd dense;
+    Vector rhs;
   };
 
-  Vector solve_active(const SparseMatrix& a, const Vector& c, const std::vector<char>& active, ActiveBase& base,
-                      SolverStats& stats);
-  Vector solve_system(const SparseMatrix& m, const Vector& rhs, SolverStats& stats, FactorPtr* keep);
-  Vector solve_dense(const SparseMatrix& m, const Vector& rhs, double pivot_floor, SolverStats& stats);
-  Vector solve_sparse(const SparseMatrix& m, const Vector& rhs, double pivot_floor, SolverStats& stats,
-                      FactorPtr* keep);
-  bool solve_updated(const Factor& base, const std::vector<char>& in_base, const SparseMatrix& a,
-                     const Vector& c, const std::vector<char>& active, Vector& p, SolverStats& stats) const;
+  Vector solve_active(const SparseMatrix& a, double shift, const Vector& r, const std::vector<char>& active,
+                      ActiveLoop& loop, SolverStats& stats);
+  Vector solve_complementarity_min_norm(const ComplementarityProblem& problem, SolverStats& stats);
+  Vector solve_system(const SparseMatrix& m, const Vector& rhs, SolverStats& stats);
+  Vector solve_dense_matrix(const Eigen::MatrixXd& a, const Vector& rhs, SolverStats& stats);
+  Vector solve_sparse(const SparseMatrix& m, const Vector& rhs, double pivot_floor, SolverStats& stats);
+  bool solve_updated(const ActiveLoop& loop, const SparseMatrix& a, double shift, const Vector& c,
+                     const std::vector<char>& active, Vector& p, SolverStats& stats);
+  void polish_minimum_norm(const SparseMatrix& a, const Vector& c, std::vector<char> rows,
+                           const ComplementarityProblem& problem, Vector& p, SolverStats& stats);
   FactorPtr checkout(const SparseMatrix& m, SolverStats& stats);
   void checkin(FactorPtr factor);
+  std::unique_ptr<MaskedLdlt> checkout_masked(const SparseMatrix& m, SolverStats& stats);
+  void checkin_masked(std::unique_ptr<MaskedLdlt> factor);
 
   SolverSettings settings_;
   std::vector<FactorPtr> cache_;  // sparse factorizations by pattern, least recently used first
+  std::vector<std::unique_ptr<MaskedLdlt>> masked_cache_;  // active-set factorizations by pattern, ditto
+  Workspace work_;
 };
 
 /// The principal submatrix A_SS of `a` for the rows `subset` (increasing).

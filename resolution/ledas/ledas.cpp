@@ -1,6 +1,7 @@
 #include "ledas/ledas.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 #include <string>
@@ -25,32 +26,69 @@ constexpr double kPositionTolerance = 1e-12;
 constexpr double kJointTolerance = 1e-9;
 
 // A of eq. 7 over an island's rows (local indices), both triangles stored. A_ik ≠ 0 only where rows i
-// and k share a movable body, so the pairs come from each body's list of rows.
+// and k share a movable body, so column k is the union of the row lists of k's (at most two) movable
+// bodies, written in compressed form directly (no triplets, no sort of pairs).
 SparseMatrix assemble_matrix(std::span<const ImpulseRow> rows, std::span<const std::uint32_t> island,
                              std::span<const RigidBody> bodies) {
-  std::vector<std::pair<BodyIndex, RowIndex>> touches;
-  for (std::size_t i = 0; i < island.size(); ++i) {
+  const std::size_t m = island.size();
+  // Movable bodies of the island, and each one's rows (increasing).
+  std::vector<BodyIndex> movable;
+  movable.reserve(2 * m);
+  for (std::uint32_t g : island)
+    for (BodyIndex body : {rows[g].a, rows[g].b})
+      if (!bodies[body].fixed) movable.push_back(body);
+  std::sort(movable.begin(), movable.end());
+  movable.erase(std::unique(movable.begin(), movable.end()), movable.end());
+  const auto slot_of = [&](BodyIndex body) -> int {
+    if (bodies[body].fixed) return -1;
+    return static_cast<int>(std::lower_bound(movable.begin(), movable.end(), body) - movable.begin());
+  };
+  std::vector<std::array<int, 2>> slots(m);
+  std::vector<int> start(movable.size() + 1, 0);
+  for (std::size_t i = 0; i < m; ++i) {
     const ImpulseRow& r = rows[island[i]];
-    if (!bodies[r.a].fixed) touches.emplace_back(r.a, static_cast<RowIndex>(i));
-    if (!bodies[r.b].fixed && r.b != r.a) touches.emplace_back(r.b, static_cast<RowIndex>(i));
+    slots[i] = {slot_of(r.a), r.b == r.a ? -1 : slot_of(r.b)};
+    for (int s : slots[i])
+      if (s >= 0) ++start[static_cast<std::size_t>(s) + 1];
   }
-  std::sort(touches.begin(), touches.end());
-  std::vector<std::pair<RowIndex, RowIndex>> pairs;
-  for (std::size_t begin = 0, end = 0; begin < touches.size(); begin = end) {
-    while (end < touches.size() && touches[end].first == touches[begin].first) ++end;
-    for (std::size_t i = begin; i < end; ++i)
-      for (std::size_t k = begin; k < end; ++k) pairs.emplace_back(touches[i].second, touches[k].second);
+  for (std::size_t s = 0; s < movable.size(); ++s) start[s + 1] += start[s];
+  std::vector<int> body_rows(static_cast<std::size_t>(start.back()));
+  {
+    std::vector<int> fill(start.begin(), start.end() - 1);
+    for (std::size_t i = 0; i < m; ++i)
+      for (int s : slots[i])
+        if (s >= 0) body_rows[static_cast<std::size_t>(fill[static_cast<std::size_t>(s)]++)] = static_cast<int>(i);
   }
-  std::sort(pairs.begin(), pairs.end());  // rows sharing both bodies appear twice: coupling() sums both
-  pairs.erase(std::unique(pairs.begin(), pairs.end()), pairs.end());
-  std::vector<Eigen::Triplet<double>> entries;
-  entries.reserve(pairs.size());
-  for (auto [i, k] : pairs)
-    entries.emplace_back(static_cast<int>(i), static_cast<int>(k), resolution::coupling(rows[island[i]], rows[island[k]]));
-  const auto m = static_cast<Eigen::Index>(island.size());
-  SparseMatrix a(m, m);
-  a.setFromTriplets(entries.begin(), entries.end());
-  a.makeCompressed();
+  const auto list = [&](int s) {
+    if (s < 0) return std::span<const int>();
+    return std::span<const int>(body_rows.data() + start[static_cast<std::size_t>(s)],
+                                body_rows.data() + start[static_cast<std::size_t>(s) + 1]);
+  };
+  const auto em = static_cast<Eigen::Index>(m);
+  SparseMatrix a(em, em);
+  std::size_t nonzeros = 0;
+  for (std::size_t k = 0; k < m; ++k) nonzeros += list(slots[k][0]).size() + list(slots[k][1]).size();
+  a.resizeNonZeros(static_cast<Eigen::Index>(nonzeros));
+  int* outer = a.outerIndexPtr();
+  int* inner = a.innerIndexPtr();
+  double* value = a.valuePtr();
+  int q = 0;
+  for (std::size_t k = 0; k < m; ++k) {
+    outer[k] = q;
+    const std::span<const int> x = list(slots[k][0]), y = list(slots[k][1]);
+    std::size_t u = 0, v = 0;
+    while (u < x.size() || v < y.size()) {  // merge two increasing lists; rows sharing both bodies once
+      int i;
+      if (v == y.size() || (u < x.size() && x[u] < y[v])) i = x[u++];
+      else if (u == x.size() || y[v] < x[u]) i = y[v++];
+      else i = x[u++], ++v;
+      inner[q] = i;
+      value[q] = resolution::coupling(rows[island[static_cast<std::size_t>(i)]], rows[island[k]]);
+      ++q;
+    }
+  }
+  outer[m] = q;
+  a.resizeNonZeros(q);
   return a;
 }
 
@@ -107,6 +145,7 @@ LedasSettings LedasSettings::from_options(const ModuleOptions& options) {
   s.solver.rank_tolerance = options.number("rank_tolerance", s.solver.rank_tolerance, 1e-16, 1e-2);
   s.solver.update_limit = static_cast<std::size_t>(
       options.integer("update_limit", static_cast<long long>(s.solver.update_limit), 0, 10'000));
+  s.solver.regularization = options.number("regularization", s.solver.regularization, 1e-16, 1e-2);
   s.solver.max_iterations = s.max_rounds;
   s.resting = resolution::RestingSettings::from_options(options);
   return s;
@@ -270,18 +309,106 @@ bool LedasResolver::retarget_joints(Island& island, const Vector& v, std::span<c
 
 // The paper's rounds (sec. 3.2): only approaching contacts enter; A p = b as equalities; (1 + e) p;
 // re-check every contact; repeat until none approaches. Joint rows ride along in every round.
+// The rounds are many (line N = 100: ~10⁵), so each is kept cheap without changing what it computes:
+// a row's velocity is re-evaluated only when the round moved one of its bodies, as the Jacobian
+// product v_n = n·(v_b − v_a) + (r_b×n)·ω_b − (r_a×n)·ω_a (eq. 5 with (ω×r)·n = ω·(r×n); fixed bodies'
+// share precomputed), the subset's system is split into its independent blocks (solve_subset), and
+// nothing is allocated per round.
 void LedasResolver::velocity_paper(Island& island, std::span<RigidBody> bodies, ResolverCounters& counters) {
   const std::size_t m = island.rows.size();
+  const std::size_t nb = island.bodies.size();
+  // Per row: its movable bodies' slots in island.bodies (−1 for a fixed body) and the fixed bodies'
+  // share of v_n. Per body: its rows (local indices).
+  std::vector<std::array<std::int32_t, 2>> slots(m);
+  std::vector<double> fixed_share(m, 0.0);
+  std::vector<std::uint32_t> body_start(nb + 1, 0), body_rows;
+  for (std::size_t i = 0; i < m; ++i) {
+    const ImpulseRow& r = rows_[island.rows[i]];
+    const ledas::RowInfo& ri = info_[island.rows[i]];
+    int k = 0;
+    for (BodyIndex body : {r.a, r.b}) {
+      const bool is_b = k == 1;
+      if (bodies[body].fixed) {
+        slots[i][static_cast<std::size_t>(k)] = -1;
+        const double u = bodies[body].velocity_at(is_b ? ri.point_b : r.point).dot(r.normal);
+        fixed_share[i] += is_b ? u : -u;
+      } else {
+        const auto s = std::lower_bound(island.bodies.begin(), island.bodies.end(), body) - island.bodies.begin();
+        slots[i][static_cast<std::size_t>(k)] = static_cast<std::int32_t>(s);
+        if (!(is_b && r.a == r.b)) ++body_start[static_cast<std::size_t>(s) + 1];
+      }
+      ++k;
+    }
+  }
+  for (std::size_t s = 0; s < nb; ++s) body_start[s + 1] += body_start[s];
+  body_rows.resize(body_start.back());
+  {
+    std::vector<std::uint32_t> fill(body_start.begin(), body_start.end() - 1);
+    for (std::size_t i = 0; i < m; ++i)
+      for (int k = 0; k < 2; ++k)
+        if (const std::int32_t s = slots[i][static_cast<std::size_t>(k)]; s >= 0 && !(k == 1 && slots[i][0] == s))
+          body_rows[fill[static_cast<std::size_t>(s)]++] = static_cast<std::uint32_t>(i);
+  }
+  const auto velocity = [&](std::size_t i) {
+    const ImpulseRow& r = rows_[island.rows[i]];
+    double u = fixed_share[i];
+    if (slots[i][0] >= 0) {
+      const RigidBody& a = bodies[r.a];
+      u -= r.normal.dot(a.velocity) + r.arm_a.dot(a.angular_velocity);
+    }
+    if (slots[i][1] >= 0) {
+      const RigidBody& b = bodies[r.b];
+      u += r.normal.dot(b.velocity) + r.arm_b.dot(b.angular_velocity);
+    }
+    return u;
+  };
+  std::vector<std::uint64_t> row_stamp(m, 0), body_stamp(nb, 0);
+  std::vector<std::uint32_t> stale;  // rows whose velocity the round changed
+  stale.reserve(m);
+  std::uint64_t stamp = 0;
+  Vector v(static_cast<Eigen::Index>(m));
+  for (std::size_t i = 0; i < m; ++i) v(static_cast<Eigen::Index>(i)) = velocity(i);
+  const auto mark_moved = [&](std::span<const RowIndex> rows) {  // the rows of the bodies `rows` move
+    ++stamp;
+    stale.clear();
+    for (RowIndex i : rows)
+      for (const std::int32_t s : slots[i]) {
+        if (s < 0 || body_stamp[static_cast<std::size_t>(s)] == stamp) continue;
+        body_stamp[static_cast<std::size_t>(s)] = stamp;
+        for (std::uint32_t k = body_start[static_cast<std::size_t>(s)]; k < body_start[static_cast<std::size_t>(s) + 1]; ++k)
+          if (const std::uint32_t row = body_rows[k]; row_stamp[row] != stamp) {
+            row_stamp[row] = stamp;
+            stale.push_back(row);
+          }
+      }
+  };
+  const auto refresh = [&] {
+    for (std::uint32_t i : stale) v(i) = velocity(i);
+  };
+  const bool bouncing = island.restitution.size() > 0 && island.restitution.maxCoeff() > 0.0;
+  bool position_joints = false;
+  for (std::size_t i = 0; i < m; ++i) position_joints = position_joints || info_[island.rows[i]].position_level;
+  Vector target = island.target, rhs = Vector::Zero(static_cast<Eigen::Index>(m)), p = rhs;
+  std::vector<RowIndex> subset;
+  subset.reserve(m);
+  const auto measure_complementarity = [&] {  // after an inelastic phase, over every contact
+    island.complementarity = 0.0;
+    for (std::size_t i = 0; i < m; ++i) {
+      const auto ei = static_cast<Eigen::Index>(i);
+      if (!island.equality[i])
+        island.complementarity = std::max(island.complementarity, std::abs(island.impulse_inelastic(ei) * (v(ei) - target(ei))));
+    }
+  };
   for (std::uint64_t round = 0;; ++round) {
-    const Vector v = island.velocities(rows_, info_, bodies);
-    const bool refine_joints = retarget_joints(island, v, bodies) && round > 0;
-    std::vector<RowIndex> subset;
+    const bool refine_joints = position_joints && retarget_joints(island, v, bodies) && round > 0;
+    for (RowIndex i : subset) target(i) = island.target(i);  // last round's solve targets
+    subset.clear();
     bool approaching = false, joint_violated = false;
-    Vector target = island.target;
     for (std::size_t i = 0; i < m; ++i) {
       const auto ei = static_cast<Eigen::Index>(i);
       if (island.equality[i]) {
         joint_violated = joint_violated || std::abs(v(ei) - island.target(ei)) > settings_.tolerance;
+        target(ei) = island.target(ei);
         subset.push_back(static_cast<RowIndex>(i));
       } else if (v(ei) < island.target(ei) - settings_.tolerance) {  // approaching (or closing its gap)
         approaching = true;
@@ -294,15 +421,38 @@ void LedasResolver::velocity_paper(Island& island, std::span<RigidBody> bodies, 
       ++counters.non_converged;
       break;
     }
-    const Vector p = solver_.solve_subset(island.a, target - v, subset, stats_.velocity);
+    for (RowIndex i : subset) rhs(i) = target(i) - v(i);
+    solver_.solve_subset(island.a, rhs, subset, p, stats_.velocity);
     ++stats_.systems;
-    const double roundoff = kRoundoff * p.lpNorm<Eigen::Infinity>();
-    for (RowIndex i : subset)
+    double largest = 0.0;
+    for (RowIndex i : subset) largest = std::max(largest, std::abs(p(i)));
+    const double roundoff = kRoundoff * largest;
+    for (RowIndex i : subset) {
       if (!island.equality[i] && p(i) < -roundoff) ++stats_.pulling_applied;
-    for (RowIndex i : subset) island.entered[i] = 1;
-    finish_round(island, p, target, bodies);
+      island.entered[i] = 1;
+    }
+    // The inelastic phase p, then the restitution phase e p (as finish_round, on the subset only: the
+    // other rows' impulses are zero).
+    for (RowIndex i : subset) {
+      resolution::apply_row_impulse(rows_[island.rows[i]], p(i), bodies);
+      island.impulse_inelastic(i) += p(i);
+    }
+    mark_moved(subset);
+    refresh();
+    if (bouncing) {
+      measure_complementarity();
+      for (RowIndex i : subset)
+        if (island.restitution(i) != 0.0) resolution::apply_row_impulse(rows_[island.rows[i]], island.restitution(i) * p(i), bodies);
+      refresh();
+    }
+    for (RowIndex i : subset) {
+      island.impulse_total(i) += (1.0 + island.restitution(i)) * p(i);
+      p(i) = 0.0;
+    }
     ++island.rounds;
   }
+  // Without restitution the state after the last inelastic phase is the final one.
+  if (!bouncing && island.rounds > 0) measure_complementarity();
 }
 
 // The exact impact (a linear complementarity problem), then (1 + e) p. Restitution can make a contact

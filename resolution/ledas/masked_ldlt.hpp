@@ -1,0 +1,73 @@
+#pragma once
+/// \file
+/// LDLᵀ of a principal submatrix A_FF of a symmetric positive semi-definite matrix A (the paper's eq. 7
+/// matrix of one island), for a set F of rows that changes from call to call while A's sparsity pattern
+/// does not. Rows outside F are replaced by identity rows, so one symbolic analysis (AMD ordering,
+/// elimination tree, column counts) of A's full pattern serves every F of an active-set loop, and every
+/// step while the contact graph is unchanged.
+///
+/// Rank: a row whose pivot is ≤ rank_tolerance · A_kk is (to that tolerance) a linear combination of the
+/// rows of F eliminated before it — a redundant contact (the paper's Figure 2, a pyramid's horizontal
+/// contacts). It is *dropped*: treated as an identity row, so A_FF z = c is solved on an independent
+/// subset B ⊆ F with z = 0 on the dropped rows (a basic solution). When c_F is in the range of A_FF
+/// (always for contacts with zero targets: c = −G v⁻), that is an exact solution of A_FF z = c_F, and
+/// every solution gives the same A z (the same velocities); only the split of the impulse among
+/// redundant rows differs from the minimum-norm one.
+///
+/// Up-looking sparse LDLᵀ (T. Davis, "Algorithm 849: a concise sparse Cholesky factorization package").
+/// No allocation after analyze(); deterministic.
+
+#include <Eigen/SparseCore>
+
+#include <cstdint>
+#include <span>
+#include <vector>
+
+namespace impetus::ledas {
+
+class MaskedLdlt {
+ public:
+  using Matrix = Eigen::SparseMatrix<double>;
+
+  /// Symbolic analysis of the pattern of `a` (square, both triangles and the diagonal stored, compressed).
+  void analyze(const Matrix& a);
+  /// Whether `a` has the pattern analyze() was given.
+  bool same_pattern(const Matrix& a) const;
+
+  /// Numeric factorization of A_FF, F = {k : on[k] != 0}; returns the number of dropped rows (see the
+  /// file comment). A row with A_kk ≤ floor (nothing movable behind it) is dropped too.
+  /// With `shift` > 0 it factorizes A_FF + shift·I instead (positive definite: only rows with
+  /// A_kk ≤ floor are dropped).
+  std::size_t factorize(const Matrix& a, std::span<const char> on, double rank_tolerance, double floor,
+                        double shift = 0.0);
+
+  /// Solves A_FF x_F = b_F in place (original row order, size n): on exit x is 0 outside F and on the
+  /// dropped rows.
+  void solve(Eigen::Ref<Eigen::VectorXd> x) const;
+
+  /// Rows of the last (shifted) factorization whose pivot is at most √(shift·A_kk): the rows (nearly)
+  /// dependent on the rows eliminated before them (A_FF is singular if there is one).
+  std::size_t redundant_rows(double shift) const;
+  /// Whether row k (original index) was dropped by the last factorize().
+  bool dropped(std::size_t k) const { return state_[static_cast<std::size_t>(new_of_old_[k])] == kDropped; }
+  std::size_t rows() const { return order_.size(); }
+  /// Entries of L the full pattern allows (work per solve ~ 2× this).
+  std::size_t capacity() const { return l_index_.size(); }
+
+ private:
+  static constexpr char kOff = 0, kOn = 1, kDropped = 2;
+
+  std::vector<int> outer_, inner_;       // the analysed pattern of A
+  std::vector<int> order_, new_of_old_;  // order_[new] = old
+  // Upper triangle of P A Pᵀ by columns (rows i ≤ k), each entry pointing into A's value array.
+  std::vector<int> c_outer_, c_row_, c_value_;
+  std::vector<int> parent_, l_outer_;    // elimination tree; column starts of L
+  std::vector<int> l_count_, l_index_;
+  std::vector<double> l_value_, d_, diag_;
+  std::vector<char> state_;
+  // Workspace.
+  mutable std::vector<double> y_;
+  std::vector<int> flag_, pattern_;
+};
+
+}  // namespace impetus::ledas
