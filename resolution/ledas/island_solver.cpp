@@ -517,7 +517,7 @@ Vector IslandSolver::solve_complementarity_min_norm(const ComplementarityProblem
   std::vector<char> free_rows(m);
   for (std::size_t k = 0; k < m; ++k) free_rows[k] = problem.equality[k] || problem.start[k];
   Vector p = Vector::Zero(a.rows());
-  bool converged = false, not_finite = false;
+  bool converged = false, not_finite = false, infeasible = false;
   for (std::uint64_t iteration = 0; iteration < settings_.max_iterations; ++iteration) {
     ++stats.iterations;
     const std::uint64_t singular_before = stats.singular;
@@ -570,7 +570,11 @@ Vector IslandSolver::solve_complementarity_min_norm(const ComplementarityProblem
         const double ratio = std::max(0.0, p(i)) / -direction(i);
         if (ratio < step) step = ratio, blocking = k;
       }
-      if (blocking == m) break;  // the objective falls without bound: the problem has no solution
+      if (blocking == m) {  // the objective falls without bound: the problem has no solution
+        infeasible = true;
+        ++stats.infeasible;
+        break;
+      }
       if (!along_null) step = std::min(step, 1.0);
       p += step * direction;
       const double floor = kImpulseRoundoff * p.lpNorm<Eigen::Infinity>();
@@ -603,7 +607,7 @@ Vector IslandSolver::solve_complementarity_min_norm(const ComplementarityProblem
       break;
     }
   }
-  if (!converged && !not_finite) ++stats.non_converged;
+  if (!converged && !not_finite && !infeasible) ++stats.non_converged;
   for (std::size_t k = 0; k < m; ++k)
     if (inequality(k)) p(static_cast<Eigen::Index>(k)) = free_rows[k] ? std::max(p(static_cast<Eigen::Index>(k)), 0.0) : 0.0;
   return p;

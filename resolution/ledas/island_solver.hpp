@@ -64,6 +64,9 @@ struct SolverStats {
   std::uint64_t released = 0;     ///< rows released because their impulse came out negative (pulling)
   std::uint64_t added = 0;        ///< rows added because they would have approached
   std::uint64_t non_converged = 0;  ///< complementarity problems that hit max_iterations
+  /// Problems with no solution (conflicting targets, e.g. a position correction squeezing a body
+  /// between fixed bodies): solved as far as the ratio test allows, counted here, not in non_converged.
+  std::uint64_t infeasible = 0;
   std::uint64_t nan_caught = 0;   ///< systems whose solution was not finite (zero returned)
   std::uint64_t polished = 0;     ///< complementarity solutions replaced by the minimum-norm split
   std::uint64_t proximal = 0;     ///< proximal outer iterations after the first

@@ -182,7 +182,10 @@ void LedasResolver::resolve(std::span<RigidBody> bodies, std::span<Contact> cont
   }
   counters.rounds += stats_.systems;
   counters.pulling_impulses += stats_.pulling_applied + stats_.velocity.released;
-  counters.non_converged += stats_.velocity.non_converged + stats_.position.non_converged;
+  // A velocity problem without a solution (conflicting joint targets) fails the step's promise; a
+  // position correction without one (a body squeezed between fixed bodies) is corrected as far as it
+  // can be, and shows only in last_stats().position.infeasible.
+  counters.non_converged += stats_.velocity.non_converged + stats_.velocity.infeasible + stats_.position.non_converged;
   counters.singular_systems += stats_.velocity.singular + stats_.position.singular;
   counters.nan_caught += stats_.velocity.nan_caught + stats_.position.nan_caught;
 }
