@@ -37,6 +37,9 @@ std::unique_ptr<CollisionResolver> make_resolver(const std::string& name) {
   }
   LedasSettings s;
   s.mode = name == "ledas_paper" ? LedasMode::paper : LedasMode::complementary;
+  // The paper mode needs ~10 N² rounds on the line with e = 0 (101 559 for N = 100): the benchmark caps it
+  // at 2·10⁵ rounds per island so the large rows end in seconds and show non_converged instead.
+  if (s.mode == LedasMode::paper) s.max_rounds = 200000;
   s.resting.correction = 0.0;
   return std::make_unique<LedasResolver>(s);
 }
@@ -90,6 +93,12 @@ void resolve(benchmark::State& state, const std::string& resolver_name, const st
   state.counters["exact"] = exact ? 1.0 : 0.0;
 }
 
+/// Rows left out: the paper mode on pyramid K = 100 (tens of thousands of rounds on 15 000 contacts) and
+/// on the line N = 10 000 with e = 0 (its round cap times 10⁴ rows: minutes per iteration).
+bool too_slow(const std::string& resolver, const std::string& scene) {
+  return resolver == "ledas_paper" && (scene == "pyramid_100" || scene == "line_10000_e0");
+}
+
 /// Registers every resolver on every scene. IMPETUS_BENCH_MAX_BODIES (default: all) skips larger scenes,
 /// for a quick run; the sequential resolver's slowest rows are still bounded by its impulse cap.
 int register_all() {
@@ -103,7 +112,7 @@ int register_all() {
   }
   for (const std::string resolver : {"ledas", "ledas_paper", "mirtich"}) {
     for (const auto& [key, bodies] : scenes) {
-      if (bodies > max_bodies) continue;
+      if (bodies > max_bodies || too_slow(resolver, key)) continue;
       benchmark::RegisterBenchmark(("resolve/" + resolver + "/" + key).c_str(),
                                    [resolver, key](benchmark::State& st) { resolve(st, resolver, key); })
           ->Unit(benchmark::kMillisecond);

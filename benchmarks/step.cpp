@@ -27,6 +27,9 @@ std::shared_ptr<CollisionResolver> make_resolver(const std::string& name) {
   if (name == "mirtich") return std::make_shared<MirtichResolver>(MirtichSettings{});
   LedasSettings s;
   s.mode = name == "ledas_paper" ? LedasMode::paper : LedasMode::complementary;
+  // The paper mode needs ~10 N² rounds on the line with e = 0 (101 559 for N = 100): the benchmark caps it
+  // at 2·10⁵ rounds per island so the large rows end in seconds and show non_converged instead.
+  if (s.mode == LedasMode::paper) s.max_rounds = 200000;
   return std::make_shared<LedasResolver>(s);
 }
 
@@ -88,7 +91,7 @@ int register_all() {
   const long max_bodies = cap ? std::atol(cap) : 1L << 40;
   for (const std::string resolver : {"ledas", "ledas_paper", "mirtich"}) {
     for (int k : {3, 4, 10, 20, 50, 100}) {
-      if (k * (k + 1) / 2 > max_bodies) continue;
+      if (k * (k + 1) / 2 > max_bodies || (resolver == "ledas_paper" && k == 100)) continue;  // see resolve.cpp
       benchmark::RegisterBenchmark(("step/" + resolver + "/pyramid_" + std::to_string(k)).c_str(),
                                    [resolver, k](benchmark::State& st) { step(st, resolver, true, k, 0.0); })
           ->Unit(benchmark::kMillisecond);
@@ -96,6 +99,7 @@ int register_all() {
     for (int n : {10, 100, 1000, 10000}) {
       if (n > max_bodies) continue;
       for (double e : {0.0, 1.0}) {
+        if (resolver == "ledas_paper" && n == 10000 && e == 0.0) continue;  // see resolve.cpp
         const std::string name = "step/" + resolver + "/line_" + std::to_string(n) + (e > 0 ? "_e1" : "_e0");
         benchmark::RegisterBenchmark(name.c_str(), [resolver, n, e](benchmark::State& st) { step(st, resolver, false, n, e); })
           ->Unit(benchmark::kMillisecond);

@@ -16,7 +16,7 @@ py=/usr/bin/python3
 "$root/scripts/build.sh" -DIMPETUS_BUILD_BENCHMARKS=ON >/dev/null
 data="$root/docs/data"
 mkdir -p "$data"
-reps=5
+reps=${IMPETUS_BENCH_REPETITIONS:-5}
 if [ $quick = 1 ]; then
   reps=3
   export IMPETUS_BENCH_MAX_BODIES=210
