@@ -6,11 +6,24 @@
 #include "impetus/assets/mesh_validation.hpp"
 #include "impetus/core/error.hpp"
 
+#include <cstdio>
+
 namespace impetus::assets {
 
 MeshBody make_mesh_body(const TriangleMesh& mesh, const std::string& label) {
   MeshBody body;
   body.unit = polyhedral_mass_properties(mesh, 1.0);
+  // A closed, consistently oriented mesh that intersects itself passes validation, but its integrals
+  // are not those of a solid: a principal moment can come out negative or break I1 + I2 >= I3 (found
+  // by fuzz/mesh_off). Refuse it here rather than hand a body an impossible inertia.
+  const Vec3& moments = body.unit.principal_moments;  // ascending
+  if (!moments.allFinite() || !body.unit.center_of_mass.allFinite() || !(moments[0] > 0.0) ||
+      moments[0] + moments[1] < moments[2] * (1.0 - 1e-9)) {
+    char text[160];
+    std::snprintf(text, sizeof text, "(%.6g, %.6g, %.6g)", moments[0], moments[1], moments[2]);
+    throw Error(label + ": its principal moments of inertia " + text +
+                " are not those of any solid: the mesh probably intersects itself");
+  }
   body.center_of_mass_file = body.unit.center_of_mass;
   // The body frame of shared/DESIGN.md: origin at the center of mass, axes as in the file (so a body
   // with the identity orientation looks as modelled; the inertia is then a full tensor).

@@ -118,11 +118,22 @@ Scene load_scene_text(const std::string& yaml, const std::string& name, const st
 }
 
 Scene load_scene(const std::filesystem::path& file, const std::vector<SceneOverride>& overrides) {
+  // A directory opens as a stream on Linux and reads as nothing; say what it is instead.
+  std::error_code ec;
+  if (std::filesystem::is_directory(file, ec))
+    throw Error(file.string() + ": is a directory, not a scene file");
+  // Refuse enormous files before reading them into memory (a scene is a few kilobytes; generators make
+  // big scenes from a few lines).
+  constexpr std::uintmax_t kMaxSceneBytes = std::uintmax_t{64} << 20;
+  if (const std::uintmax_t size = std::filesystem::file_size(file, ec); !ec && size > kMaxSceneBytes)
+    throw Error(file.string() + ": the scene file is " + std::to_string(size) +
+                " bytes, larger than the limit of " + std::to_string(kMaxSceneBytes) + " bytes (64 MiB)");
   std::ifstream in(file, std::ios::binary);
   if (!in) throw Error(file.string() + ": cannot open the scene file: " + std::strerror(errno));
   std::ostringstream text;
   text << in.rdbuf();
   if (in.bad()) throw Error(file.string() + ": cannot read the scene file");
+  if (text.str().empty()) throw Error(file.string() + ": the scene file is empty");
   Scene scene = load_scene_text(text.str(), file.string(), file.parent_path(), overrides);
   scene.file = file;
   return scene;

@@ -7,6 +7,7 @@
 
 #include <Eigen/Eigenvalues>
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 
@@ -119,8 +120,12 @@ Mat3 read_inertia(const SceneReader& r, const YAML::Node& node) {
 // `orientation: [w, x, y, z]`, normalized; the zero quaternion has no direction.
 Mat3 read_orientation(const SceneReader& r, const YAML::Node& node) {
   const std::vector<double> q = r.numbers(node, "orientation", 4);
-  const Quat quat(q[0], q[1], q[2], q[3]);
-  if (quat.norm() == 0.0) r.fail(node, "'orientation' is the zero quaternion; give [w, x, y, z] with w, x, y, z not all 0");
+  // Divide by the largest component first: the squared norm of [1e300, …] overflows to inf and that of
+  // [1e-200, …] underflows to 0, though both have a direction.
+  double largest = 0.0;
+  for (double x : q) largest = std::max(largest, std::abs(x));
+  if (largest == 0.0) r.fail(node, "'orientation' is the zero quaternion; give [w, x, y, z] with w, x, y, z not all 0");
+  const Quat quat(q[0] / largest, q[1] / largest, q[2] / largest, q[3] / largest);
   return quat.normalized().toRotationMatrix();
 }
 

@@ -1,0 +1,106 @@
+// The fuzz targets (see targets.hpp). Shared by the libFuzzer binaries and tests/reliability.
+
+#include "targets.hpp"
+
+#include "impetus/assets/mesh_body.hpp"
+#include "impetus/core/error.hpp"
+#include "impetus/core/scene.hpp"
+#include "impetus/core/world.hpp"
+
+#include <unistd.h>
+
+#include <Eigen/Eigenvalues>
+
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <string>
+
+#ifndef IMPETUS_FUZZ_SCENE_DIR
+#error "IMPETUS_FUZZ_SCENE_DIR must be defined by the build (the bundled scene directory)"
+#endif
+
+namespace impetus::fuzz {
+namespace {
+
+namespace fs = std::filesystem;
+
+[[noreturn]] void invariant_broken(const std::string& what) {
+  std::fprintf(stderr, "impetus fuzz: invariant broken: %s\n", what.c_str());
+  std::fflush(stderr);
+  std::abort();
+}
+
+// A private directory for the mesh files, removed when the process exits normally.
+class ScratchDir {
+ public:
+  ScratchDir() {
+    std::error_code ec;
+    path_ = fs::temp_directory_path(ec) / ("impetus-fuzz-" + std::to_string(getpid()));
+    fs::create_directories(path_, ec);
+  }
+  ~ScratchDir() {
+    std::error_code ec;
+    fs::remove_all(path_, ec);
+  }
+  ScratchDir(const ScratchDir&) = delete;
+  ScratchDir& operator=(const ScratchDir&) = delete;
+  const fs::path& path() const { return path_; }
+
+ private:
+  fs::path path_;
+};
+
+}  // namespace
+
+Outcome scene_one_input(const std::uint8_t* data, std::size_t size) {
+  const std::string text(reinterpret_cast<const char*>(data), size);
+  Scene scene;
+  try {
+    scene = load_scene_text(text, "fuzz.yaml", IMPETUS_FUZZ_SCENE_DIR);
+  } catch (const Error&) {
+    return Outcome::rejected;
+  }
+  // What the loader accepts, the World must accept: the same checks live in both places.
+  try {
+    World world(scene.settings);
+    for (const RigidBody& body : scene.bodies) world.add_body(body);
+    for (const Constraint& constraint : scene.constraints) world.add_constraint(constraint);
+  } catch (const Error& e) {
+    invariant_broken(std::string("the scene loaded but the World refused it: ") + e.what());
+  }
+  return Outcome::accepted;
+}
+
+Outcome mesh_one_input(const std::uint8_t* data, std::size_t size, const std::string& extension) {
+  static const ScratchDir scratch;
+  const fs::path file = scratch.path() / ("input." + extension);
+  {
+    std::ofstream out(file, std::ios::binary | std::ios::trunc);
+    out.write(reinterpret_cast<const char*>(data), static_cast<std::streamsize>(size));
+    if (!out) invariant_broken("cannot write the scratch file " + file.string());
+  }
+  assets::MeshBody body;
+  try {
+    body = assets::load_mesh_body(file);
+  } catch (const Error&) {
+    return Outcome::rejected;
+  }
+  // Mass properties of a mesh that passed validation must describe a real solid.
+  const assets::MassProperties& unit = body.unit;
+  if (!(unit.volume > 0.0) || !std::isfinite(unit.volume))
+    invariant_broken("validated mesh with volume " + std::to_string(unit.volume));
+  if (!unit.inertia.allFinite() || !unit.center_of_mass.allFinite() || !unit.principal_moments.allFinite())
+    invariant_broken("validated mesh with non-finite mass properties");
+  const double scale = unit.inertia.cwiseAbs().maxCoeff();
+  if ((unit.inertia - unit.inertia.transpose()).cwiseAbs().maxCoeff() > 1e-9 * scale)
+    invariant_broken("validated mesh with a non-symmetric inertia");
+  if (!(unit.principal_moments.minCoeff() > -1e-9 * scale))
+    invariant_broken("validated mesh with a negative principal moment of inertia");
+  if (body.mesh == nullptr || body.mesh->triangles.empty()) invariant_broken("validated mesh without triangles");
+  return Outcome::accepted;
+}
+
+}  // namespace impetus::fuzz
