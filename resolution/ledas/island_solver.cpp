@@ -626,7 +626,7 @@ void IslandSolver::polish_minimum_norm(const SparseMatrix& a, const Vector& c, s
       rows[k] = std::abs(w) <= 0.5 * problem.tolerance;
     }
   const std::vector<RowIndex> members_f = members(rows);
-  if (members_f.size() < 2 || members_f.size() > settings_.dense_limit) return;
+  if (members_f.size() < 2 || members_f.size() > settings_.polish_limit) return;
   SolverStats ignored;
   const SparseMatrix sub = principal_submatrix(a, members_f);
   const Vector q = solve_dense_matrix(Eigen::MatrixXd(sub), gather(c, members_f), ignored);

@@ -44,6 +44,9 @@ using RowIndex = std::uint32_t;
 /// How systems are solved (configuration; read once from the resolver's options).
 struct SolverSettings {
   std::size_t dense_limit = 64;   ///< systems of at most this many rows use the dense path
+  /// Complementary mode: a final system of at most this many rows gets the minimum-norm impulse split
+  /// (an eigen-decomposition when it is singular, which costs more than the solve itself above ~16 rows).
+  std::size_t polish_limit = 16;
   double rank_tolerance = 1e-10;  ///< a pivot or eigenvalue ≤ this × max A_ii counts as zero
   std::size_t update_limit = 8;  ///< sparse path: largest active-set change solved by an update
   std::uint64_t max_iterations = 10000;  ///< active-set iterations per complementarity problem
@@ -106,7 +109,7 @@ class IslandSolver {
   /// pivoting while the number of infeasible rows falls, then the primal active-set method (monotone:
   /// it terminates), started from the given set. Returns p with p ≥ 0 on inequality rows, w ≥ −tolerance
   /// and |w| ≤ 1e-3 · tolerance on the rows with p ≠ 0; the minimum-norm split where the final system has
-  /// at most dense_limit rows and that split is ≥ 0. Conflicting targets (no exact solution): the
+  /// at most polish_limit rows and that split is ≥ 0. Conflicting targets (no exact solution): the
   /// minimum-norm least-squares active set of solve_complementarity_min_norm.
   Vector solve_complementarity(const ComplementarityProblem& problem, SolverStats& stats);
 

@@ -142,11 +142,14 @@ LedasSettings LedasSettings::from_options(const ModuleOptions& options) {
       options.integer("max_rounds", static_cast<long long>(s.max_rounds), 1, 1'000'000'000));
   s.solver.dense_limit = static_cast<std::size_t>(
       options.integer("dense_limit", static_cast<long long>(s.solver.dense_limit), 1, 100'000));
+  s.solver.polish_limit = static_cast<std::size_t>(
+      options.integer("polish_limit", static_cast<long long>(s.solver.polish_limit), 0, 100'000));
   s.solver.rank_tolerance = options.number("rank_tolerance", s.solver.rank_tolerance, 1e-16, 1e-2);
   s.solver.update_limit = static_cast<std::size_t>(
       options.integer("update_limit", static_cast<long long>(s.solver.update_limit), 0, 10'000));
   s.solver.regularization = options.number("regularization", s.solver.regularization, 1e-16, 1e-2);
   s.solver.max_iterations = s.max_rounds;
+  s.islands = options.boolean("islands", s.islands);
   s.resting = resolution::RestingSettings::from_options(options);
   return s;
 }
@@ -211,7 +214,14 @@ void LedasResolver::resolve_all(std::span<RigidBody> bodies, std::span<Contact> 
   }
   for (const Constraint& c : constraints) ledas::append_constraint_rows(bodies, c, ctx.dt, rows_, info_);
 
-  for (std::vector<std::uint32_t>& rows : resolution::find_islands(rows_, bodies.size(), bodies)) {
+  std::vector<std::vector<std::uint32_t>> islands = resolution::find_islands(rows_, bodies.size(), bodies);
+  if (!settings_.islands && islands.size() > 1) {  // one system for everything (benchmarks/model.cpp)
+    std::vector<std::uint32_t> all;
+    for (const auto& island : islands) all.insert(all.end(), island.begin(), island.end());
+    std::sort(all.begin(), all.end());
+    islands.assign(1, std::move(all));
+  }
+  for (std::vector<std::uint32_t>& rows : islands) {
     Island island = make_island(std::move(rows), bodies, ctx.dt);
     const double energy_before = kinetic_energy(bodies, island.bodies);
     if (settings_.mode == LedasMode::paper) velocity_paper(island, bodies, counters);

@@ -45,6 +45,10 @@ struct LedasSettings {
   /// Options `dense_limit`, `rank_tolerance`, `update_limit`, `regularization` (max_iterations is set to
   /// max_rounds).
   ledas::SolverSettings solver;
+  /// Solve each island (rows connected through movable bodies) on its own (default), or every row in
+  /// one system (`islands: false`: the same velocities up to rounding, with the bounce threshold judged
+  /// over all rows; only slower or faster, as benchmarks/model.cpp measures).
+  bool islands = true;
   /// Options `slop`, `correction`, `bounce_threshold` (resolution/common/resting.hpp).
   resolution::RestingSettings resting;
 
