@@ -15,6 +15,8 @@
 //                 contact is an octagon, under gravity: at most 4 points per pair (on) or all 8 (off).
 //   islands       the 16 pyramids on the fixed ground solved island by island (on) or as one system
 //                 (off, the ledas option `islands: false`).
+#include "support/bench_scenes.hpp"
+
 #include "impetus/core/scene.hpp"
 #include "impetus/core/world.hpp"
 #include "impetus/plugins/host.hpp"
@@ -98,13 +100,7 @@ void model(benchmark::State& state, const std::string& lever, bool on) {
   StepStatus last;
   for (auto _ : state) {
     state.PauseTiming();
-    std::span<RigidBody> bodies = world->bodies();
-    for (std::size_t i = 0; i < bodies.size(); ++i) {
-      bodies[i].position = initial[i].position;
-      bodies[i].rotation = initial[i].rotation;
-      bodies[i].velocity = initial[i].velocity;
-      bodies[i].angular_velocity = initial[i].angular_velocity;
-    }
+    bench::restore_state(world->bodies(), initial);
     state.ResumeTiming();
     const StepStatus& s = world->step();
     state.PauseTiming();

@@ -14,8 +14,7 @@
 //                           e = 1: residual ≤ 1e-9 m/s and |energy_change| ≤ 1e-9
 #include "support/bench_scenes.hpp"
 
-#include "ledas/ledas.hpp"
-#include "mirtich/mirtich.hpp"
+#include "support/bench_resolvers.hpp"
 
 #include <benchmark/benchmark.h>
 
@@ -29,38 +28,13 @@ namespace {
 
 using namespace impetus;
 
-std::unique_ptr<CollisionResolver> make_resolver(const std::string& name) {
-  if (name == "mirtich") {
-    MirtichSettings s;
-    s.resting.correction = 0.0;
-    return std::make_unique<MirtichResolver>(s);
-  }
-  LedasSettings s;
-  s.mode = name == "ledas_paper" ? LedasMode::paper : LedasMode::complementary;
-  // The paper mode needs ~10 N² rounds on the line with e = 0 (101 559 for N = 100): the benchmark caps it
-  // at 2·10⁵ rounds per island so the large rows end in seconds and show non_converged instead.
-  if (s.mode == LedasMode::paper) s.max_rounds = 200000;
-  s.resting.correction = 0.0;
-  return std::make_unique<LedasResolver>(s);
-}
 
-const bench::PreparedScene& scene(const std::string& key) {
-  static std::map<std::string, bench::PreparedScene> cache;
-  auto it = cache.find(key);
-  if (it != cache.end()) return it->second;
-  const auto underscore = key.find('_');
-  const std::string family = key.substr(0, underscore);
-  const int n = std::stoi(key.substr(underscore + 1));
-  const bool elastic = key.ends_with("_e1");
-  bench::PreparedScene s = family == "pyramid" ? bench::pyramid_drop(n) : bench::line_push(n, elastic ? 1.0 : 0.0);
-  return cache.emplace(key, std::move(s)).first->second;
-}
 
 void resolve(benchmark::State& state, const std::string& resolver_name, const std::string& scene_key) {
-  const bench::PreparedScene& prepared = scene(scene_key);
+  const bench::PreparedScene& prepared = bench::prepared_scene(scene_key);
   std::vector<RigidBody> bodies = prepared.bodies;
   std::vector<Contact> contacts = prepared.contacts;
-  const auto resolver = make_resolver(resolver_name);
+  const auto resolver = bench::make_resolver(resolver_name, /*velocity_only=*/true);
   ResolverCounters counters;
   const StepContext ctx{};
   for (auto _ : state) {

@@ -9,8 +9,7 @@
 #include "support/bench_scenes.hpp"
 
 #include "impetus/core/world.hpp"
-#include "ledas/ledas.hpp"
-#include "mirtich/mirtich.hpp"
+#include "support/bench_resolvers.hpp"
 #include "momentum/momentum.hpp"
 
 #include <benchmark/benchmark.h>
@@ -23,20 +22,6 @@ namespace {
 
 using namespace impetus;
 
-std::shared_ptr<CollisionResolver> make_resolver(const std::string& name) {
-  if (name == "mirtich") return std::make_shared<MirtichResolver>(MirtichSettings{});
-  LedasSettings s;
-  s.mode = name == "ledas_paper" ? LedasMode::paper : LedasMode::complementary;
-  // The paper mode needs ~10 N² rounds on the line with e = 0 (101 559 for N = 100): the benchmark caps it
-  // at 2·10⁵ rounds per island so the large rows end in seconds and show non_converged instead.
-  if (s.mode == LedasMode::paper) s.max_rounds = 200000;
-  return std::make_shared<LedasResolver>(s);
-}
-
-struct SavedState {
-  Vec3 position, velocity, angular_velocity;
-  Mat3 rotation;
-};
 
 void step(benchmark::State& state, const std::string& resolver_name, bool pyramid, int n, double restitution) {
   const std::vector<RigidBody> initial =
@@ -46,19 +31,13 @@ void step(benchmark::State& state, const std::string& resolver_name, bool pyrami
   for (const RigidBody& b : initial) world.add_body(b);
   world.set_integrator(std::make_shared<MomentumIntegrator>(ModuleOptions{}));
   world.set_detector(std::make_shared<FclDetector>());
-  world.set_resolver(make_resolver(resolver_name));
+  world.set_resolver(bench::make_resolver(resolver_name, /*velocity_only=*/false));
 
   StepProfile sum;
   StepStatus last;
   for (auto _ : state) {
     state.PauseTiming();
-    std::span<RigidBody> bodies = world.bodies();
-    for (std::size_t i = 0; i < bodies.size(); ++i) {
-      bodies[i].position = initial[i].position;
-      bodies[i].rotation = initial[i].rotation;
-      bodies[i].velocity = initial[i].velocity;
-      bodies[i].angular_velocity = initial[i].angular_velocity;
-    }
+    bench::restore_state(world.bodies(), initial);
     state.ResumeTiming();
     const StepStatus& s = world.step();
     state.PauseTiming();

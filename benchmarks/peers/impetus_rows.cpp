@@ -3,28 +3,16 @@
 // off, velocities restored before every step.
 #include "peers.hpp"
 
-#include "ledas/ledas.hpp"
-#include "mirtich/mirtich.hpp"
+#include "support/bench_resolvers.hpp"
 
 namespace impetus::peers {
 namespace {
 
-std::unique_ptr<CollisionResolver> make_resolver(const std::string& name) {
-  if (name == "mirtich") {
-    MirtichSettings s;
-    s.resting.correction = 0.0;
-    return std::make_unique<MirtichResolver>(s);
-  }
-  LedasSettings s;
-  s.mode = name == "ledas_paper" ? LedasMode::paper : LedasMode::complementary;
-  s.resting.correction = 0.0;
-  return std::make_unique<LedasResolver>(s);
-}
 
 class ImpetusStep final : public PeerStep {
  public:
   ImpetusStep(const bench::PreparedScene& scene, const std::string& resolver)
-      : scene_(scene), bodies_(scene.bodies), contacts_(scene.contacts), resolver_(make_resolver(resolver)) {}
+      : scene_(scene), bodies_(scene.bodies), contacts_(scene.contacts), resolver_(bench::make_resolver(resolver, /*velocity_only=*/true)) {}
 
   void reset() override {
     bench::restore_velocities(bodies_, scene_.bodies);

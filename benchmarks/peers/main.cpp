@@ -31,17 +31,6 @@ namespace {
 using namespace impetus;
 using namespace impetus::peers;
 
-const bench::PreparedScene& scene(const std::string& key) {
-  static std::map<std::string, bench::PreparedScene> cache;
-  auto it = cache.find(key);
-  if (it != cache.end()) return it->second;
-  const auto underscore = key.find('_');
-  const std::string family = key.substr(0, underscore);
-  const int n = std::stoi(key.substr(underscore + 1));
-  const bool elastic = key.ends_with("_e1");
-  bench::PreparedScene s = family == "pyramid" ? bench::pyramid_drop(n) : bench::line_push(n, elastic ? 1.0 : 0.0);
-  return cache.emplace(key, std::move(s)).first->second;
-}
 
 /// Copies the peer's post-step velocities into a copy of the Impetus bodies and measures them.
 void report(benchmark::State& state, const bench::PreparedScene& prepared, const StepResult& r, bool inelastic) {
@@ -74,7 +63,7 @@ void report(benchmark::State& state, const bench::PreparedScene& prepared, const
 }
 
 void run(benchmark::State& state, const Method& method, const std::string& scene_key, const StepSettings& settings) {
-  const bench::PreparedScene& prepared = scene(scene_key);
+  const bench::PreparedScene& prepared = bench::prepared_scene(scene_key);
   std::unique_ptr<PeerStep> peer;
   try {
     peer = method.make(prepared, settings);

@@ -11,6 +11,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <map>
 #include <span>
 #include <stdexcept>
 #include <string>
@@ -60,6 +61,28 @@ inline PreparedScene line_push(int count, double restitution) {
   p.count = count;
   p.restitution = restitution;
   return prepare("line_" + std::to_string(count) + (restitution > 0 ? "_e1" : "_e0"), make_line(p));
+}
+
+/// The scene named "pyramid_K", "line_N_e0" or "line_N_e1", prepared once per process.
+inline const PreparedScene& prepared_scene(const std::string& key) {
+  static std::map<std::string, PreparedScene> cache;
+  auto it = cache.find(key);
+  if (it != cache.end()) return it->second;
+  const auto underscore = key.find('_');
+  const std::string family = key.substr(0, underscore);
+  const int n = std::stoi(key.substr(underscore + 1));
+  PreparedScene s = family == "pyramid" ? pyramid_drop(n) : line_push(n, key.ends_with("_e1") ? 1.0 : 0.0);
+  return cache.emplace(key, std::move(s)).first->second;
+}
+
+/// Copies the state (pose and velocities) back from `initial`, body by body.
+inline void restore_state(std::span<RigidBody> bodies, std::span<const RigidBody> initial) {
+  for (std::size_t i = 0; i < bodies.size(); ++i) {
+    bodies[i].position = initial[i].position;
+    bodies[i].rotation = initial[i].rotation;
+    bodies[i].velocity = initial[i].velocity;
+    bodies[i].angular_velocity = initial[i].angular_velocity;
+  }
 }
 
 /// Copies velocities (and nothing else) back from the initial state: what a resolver changes.
