@@ -12,14 +12,13 @@
 //   energy_change           (E⁺ − E⁻)/E⁻ of the kinetic energy
 //   exact                   e = 0: residual ≤ 1e-9 m/s and complementarity ≤ 1e-9 N·m/s;
 //                           e = 1: residual ≤ 1e-9 m/s and |energy_change| ≤ 1e-9
-#include "support/bench_scenes.hpp"
-
 #include "support/bench_resolvers.hpp"
+#include "support/bench_scenes.hpp"
 
 #include <benchmark/benchmark.h>
 
 #include <cmath>
-#include <map>
+#include <cstdlib>
 #include <memory>
 #include <string>
 #include <vector>
@@ -27,8 +26,6 @@
 namespace {
 
 using namespace impetus;
-
-
 
 void resolve(benchmark::State& state, const std::string& resolver_name, const std::string& scene_key) {
   const bench::PreparedScene& prepared = bench::prepared_scene(scene_key);

@@ -6,14 +6,15 @@
 // Rows: step/<resolver>/<scene>. Counters: bodies, contacts, rounds, and the mean time per step of each
 // stage (velocities_ms, detect_ms, resolve_ms, positions_ms) plus resolve_share = resolve / total.
 // The resolvers run with their defaults (position correction on), as in a simulation.
+#include "support/bench_resolvers.hpp"
 #include "support/bench_scenes.hpp"
 
 #include "impetus/core/world.hpp"
-#include "support/bench_resolvers.hpp"
 #include "momentum/momentum.hpp"
 
 #include <benchmark/benchmark.h>
 
+#include <cstdlib>
 #include <memory>
 #include <string>
 #include <vector>
@@ -21,7 +22,6 @@
 namespace {
 
 using namespace impetus;
-
 
 void step(benchmark::State& state, const std::string& resolver_name, bool pyramid, int n, double restitution) {
   const std::vector<RigidBody> initial =
