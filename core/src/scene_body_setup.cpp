@@ -19,7 +19,14 @@ void set_mass_properties(RigidBody& body, const UnitMassProperties& unit, const 
   body.inv_mass = 1.0 / body.mass;
   body.inertia_body = spec.inertia_body ? *spec.inertia_body : Mat3(unit.inertia_per_density * density);
   // Symmetrize: the cofactor inverse of a symmetric matrix can differ from symmetric in the last bit.
-  const Mat3 inverse = body.inertia_body.inverse();
+  Mat3 inverse = body.inertia_body.inverse();
+  // The cofactor inverse goes through the determinant, which overflows (or underflows) for moments
+  // beyond about 1e±100 (a 1e122 kg sphere, found by fuzz/scene): invert the matrix scaled to unit size
+  // then. Ordinary bodies keep the plain inverse, bit for bit.
+  if (!inverse.allFinite() || !((body.inertia_body * inverse - Mat3::Identity()).norm() < 1e-9)) {
+    const double scale = body.inertia_body.cwiseAbs().maxCoeff();
+    inverse = (body.inertia_body / scale).inverse() / scale;
+  }
   body.inv_inertia_body = 0.5 * (inverse + inverse.transpose());
 }
 
