@@ -140,7 +140,8 @@ def paper_table(res):
             if not row or "error" in row:
                 cells.append("—")
                 continue
-            exact = "exact" if row.get("exact", 0) >= 1 else f"residual {sci(row.get('residual'))}"
+            exact = ("exact" if row.get("exact", 0) >= 1
+                     else f"residual {sci(row.get('residual'))}, complementarity {sci(row.get('complementarity'))}")
             cells.append(f"{seconds(row['seconds'])} · {speedup(t_paper / row['seconds'])} · {exact}")
         lines.append(f"| {name} | {bodies} | {contacts} | {t_paper} | " + " | ".join(cells) + " |")
     return "\n".join(lines)
