@@ -15,7 +15,7 @@
 //                 contact is an octagon, under gravity: at most 4 points per pair (on) or all 8 (off).
 //   islands       the 16 pyramids on the fixed ground solved island by island (on) or as one system
 //                 (off, the ledas option `islands: false`).
-#include "support/bench_scenes.hpp"
+#include "support/bench_steps.hpp"
 
 #include "impetus/core/scene.hpp"
 #include "impetus/core/world.hpp"
@@ -96,20 +96,7 @@ void model(benchmark::State& state, const std::string& lever, bool on) {
     return;
   }
   const std::vector<RigidBody> initial(world->bodies().begin(), world->bodies().end());
-  StepProfile sum;
-  StepStatus last;
-  for (auto _ : state) {
-    state.PauseTiming();
-    bench::restore_state(world->bodies(), initial);
-    state.ResumeTiming();
-    const StepStatus& s = world->step();
-    state.PauseTiming();
-    sum.detect += s.profile.detect;
-    sum.resolve += s.profile.resolve;
-    sum.total += s.profile.total;
-    last = s;
-    state.ResumeTiming();
-  }
+  const auto [sum, last] = bench::time_steps(state, *world, initial);
   const auto per_step = benchmark::Counter::kAvgIterations;
   state.counters["bodies"] = static_cast<double>(initial.size());
   state.counters["contacts"] = static_cast<double>(last.detector.contacts);

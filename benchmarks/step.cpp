@@ -8,6 +8,7 @@
 // The resolvers run with their defaults (position correction on), as in a simulation.
 #include "support/bench_resolvers.hpp"
 #include "support/bench_scenes.hpp"
+#include "support/bench_steps.hpp"
 
 #include "impetus/core/world.hpp"
 #include "momentum/momentum.hpp"
@@ -33,26 +34,7 @@ void step(benchmark::State& state, const std::string& resolver_name, bool pyrami
   world.set_detector(std::make_shared<FclDetector>());
   world.set_resolver(bench::make_resolver(resolver_name, /*velocity_only=*/false));
 
-  StepProfile sum;
-  StepStatus last;
-  for (auto _ : state) {
-    state.PauseTiming();
-    bench::restore_state(world.bodies(), initial);
-    state.ResumeTiming();
-    const StepStatus& s = world.step();
-    state.PauseTiming();
-    if (!s.ok) {
-      state.SkipWithError(s.message.c_str());
-      break;
-    }
-    sum.velocities += s.profile.velocities;
-    sum.detect += s.profile.detect;
-    sum.resolve += s.profile.resolve;
-    sum.positions += s.profile.positions;
-    sum.total += s.profile.total;
-    last = s;
-    state.ResumeTiming();
-  }
+  const auto [sum, last] = bench::time_steps(state, world, initial);
   const auto per_step = benchmark::Counter::kAvgIterations;
   state.counters["bodies"] = static_cast<double>(initial.size() - 1);
   state.counters["contacts"] = static_cast<double>(last.detector.contacts);
