@@ -1,13 +1,16 @@
 #!/usr/bin/env python3
 """The stability atlas and the accuracy charts from one run of the accuracy suite.
 
-    python3 scripts/accuracy.py SUITE.json DOCS_DIR
+    python3 scripts/accuracy.py SUITE.json DOCS_DIR [PEERS.json]
 
-reads the JSON written by `bench_accuracy --out SUITE.json` (benchmarks/accuracy/README.md) and writes
+reads the JSON written by `bench_accuracy --out SUITE.json` (benchmarks/accuracy/README.md) and, when it
+exists, the same scenarios run in Bullet, ODE and MuJoCo by `bench_accuracy_peers --out PEERS.json`
+(benchmarks/peers/README.md; default: accuracy_peers.json next to SUITE.json), and writes
   DOCS_DIR/stability.md                        the atlas: scenario x method, pass/fail with its figure,
-                                               and why the failing methods fail
+                                               and why the failing methods fail; then the peers' table
   DOCS_DIR/charts/accuracy_<group>.png/.svg    per scenario: time per step (x, log) against error
-                                               (y, log), one point per method x setting, Pareto front
+                                               (y, log), one point per method x setting (peers as extra
+                                               marker shapes), Pareto front over all points
   DOCS_DIR/charts/accuracy_overview.png/.svg   the headline chart (six scenarios)
 Needs matplotlib (Debian: python3-matplotlib); if the python3 on PATH lacks it, the script re-runs itself
 with /usr/bin/python3.
@@ -35,10 +38,86 @@ COLUMN_TITLES = ["ledas complementary", "ledas paper", "mirtich (sequential)", "
                  "momentum"]
 COLORS = {"ledas/complementary": "#1f77b4", "ledas/paper": "#ff7f0e", "mirtich": "#2ca02c"}
 MARKERS = {"momentum": "o", "euler": "s"}
+# Peer engines (bench_accuracy_peers): one marker shape per engine, one colour per setting.
+PEER_MARKERS = {"bullet": "^", "ode": "D", "mujoco": "P"}
+PEER_ENGINES = {"bullet": "Bullet", "ode": "ODE", "mujoco": "MuJoCo"}
+PEER_COLORS = {"bullet/si_10": "#9467bd", "bullet/si_100": "#e377c2", "ode/quickstep_20": "#8c564b",
+               "ode/worldstep": "#bcbd22", "mujoco/newton": "#17becf", "mujoco/pgs": "#7f7f7f"}
+PEER_TITLES = {"bullet/si_10": "Bullet SI 10", "bullet/si_100": "Bullet SI 100",
+               "ode/quickstep_20": "ODE QuickStep 20", "ode/worldstep": "ODE dWorldStep",
+               "mujoco/newton": "MuJoCo Newton", "mujoco/pgs": "MuJoCo PGS"}
 FLOOR = 1e-17  # an error of exactly 0 is plotted here
 OVERVIEW = ["billiards", "cradle_20", "pyramid_drop_20", "box_stack_20", "pendulum_velocity", "t_handle"]
 
 # Why a method fails a scenario: printed under the scenario only when that method fails it there.
+# How the peer engines do on each scenario (by id, else by group): one honest sentence, printed under the
+# scenario when bench_accuracy_peers ran it.
+PEER_NOTES = {
+    "two_balls":
+        "Bullet's sequential impulse solves a single contact exactly (restitution √e per body, which it "
+        "multiplies to the scene's e); ODE is off by 1e-7 m/s, the size of its default CFM 1e-10 "
+        "(the contact is slightly soft), which fails a 1e-9 criterion; MuJoCo's shipped soft contact removes "
+        "only part of the approach in one step (e = 0) and it has no coefficient of restitution (e > 0: "
+        "unsupported).",
+    "billiards":
+        "Bullet's iterations converge to the simultaneous answer, which is symmetric (3e-12 m/s after 10 "
+        "iterations, 1e-16 after 100); ODE is symmetric too but its CFM 1e-10 loses 1.6e-8 of the energy "
+        "(criterion 1e-9); MuJoCo has no restitution (unsupported).",
+    "cradle":
+        "Every peer solves the chain's contacts together with restitution as a target velocity per contact, so "
+        "where it converges it gives the simultaneous-impact answer of `ledas/complementary` (ball 1 rebounds "
+        "and the rest leave together: distance 0.6 for 5 balls, 0.9 for 20), not the classic cradle; Bullet "
+        "SI 10 and ODE QuickStep do not converge on 20 balls and also lose 10-22 % of the energy; MuJoCo has "
+        "no restitution (unsupported).",
+    "pyramid_drop":
+        "Only ODE's dWorldStep (the Dantzig LCP, with the ERP 1e-6 that keeps it from giving up) comes close: "
+        "1.7e-7 to 1.2e-6 m/s left, over the bound at K = 20 (CFM 1e-10 and the perturbation), and it is two "
+        "orders of magnitude slower than `ledas/complementary` there; the iterative solvers leave approach "
+        "that grows with K (Bullet SI 100 is exact up to K = 4, 0.06 m/s at K = 20; SI 10 and ODE QuickStep "
+        "0.25-0.35 m/s), and MuJoCo's soft contacts absorb only about 8 % of the approach in one step by "
+        "design (0.91-0.92 m/s left on every K).",
+    "figure2":
+        "ODE's dWorldStep stops the plank and lands on the minimum-norm impulses (1.6e-9: its CFM picks the "
+        "smallest of the equivalent distributions); Bullet SI and ODE QuickStep stop the plank but share the "
+        "impulse among the four corners by their sweep order (25 % and 46 % from the minimum-norm one); "
+        "MuJoCo spreads it evenly (the minimum-norm one, by symmetry) but its soft contact leaves the plank "
+        "moving at 0.9 m/s after the step.",
+    "pyramid_walls":
+        "ODE's dWorldStep holds the squeezed pyramid (top sphere 0.5 mm off, no jitter); Bullet SI and ODE QuickStep keep it up but jittering (0.04-0.16 J at rest) and 4-8 mm "
+        "deep, the steady state of their Baumgarte correction; MuJoCo's soft contacts let the frictionless "
+        "pyramid collapse (the top sphere ends about 40 m away, still sliding).",
+    "box_stack_settle":
+        "ODE's dWorldStep settles the five boxes exactly (3e-10 m); Bullet SI 100 settles them, but the top "
+        "box ends 3.5 mm from its rest position (1.3 cm deep on landing); Bullet SI 10, ODE QuickStep and both "
+        "MuJoCo solvers let the frictionless stack topple (the top box ends tens of metres away).",
+    "box_stack":
+        "Only ODE's dWorldStep keeps the frictionless stacks standing at every height (0.1-0.4 mm: the initial "
+        "overlaps pushed out); the iterative solvers (Bullet SI, ODE QuickStep, MuJoCo PGS) share each face's "
+        "impulse unevenly among its four corners, the boxes tilt and, with nothing to hold them sideways, "
+        "slide apart; MuJoCo Newton keeps 10 and 20 boxes up but 5-11 mm deep in every contact (soft by "
+        "design: the stack sinks 2.6 and 11 cm) and loses the 40-box stack, while PGS even throws the 10-box "
+        "stack apart (its top box leaves upward at 4 m/s after 0.3 s).",
+    "mass_ratio":
+        "ODE's dWorldStep holds all three ratios; Bullet SI and ODE QuickStep let the heavy box end on the "
+        "ground (through or beside the light one, a drift of about 1 m) and leave even the light-on-heavy box "
+        "1.3-27 mm low; MuJoCo passes the light-on-heavy pair with both solvers (0.8 mm low), while Newton "
+        "sinks a heavy box 4 cm (100:1) and 41 cm (1000:1) into its soft contact and PGS lets it reach the "
+        "ground.",
+    "pendulum":
+        "The peers have one joint model each (so the position- and velocity-level rows hold the same runs): "
+        "at 1/100 s every peer ends within the criterion (0.9-2.9 mm) but the gap reaches 2.4 cm during the "
+        "swing, since Bullet's and ODE's velocity-level joints are corrected by Baumgarte/ERP only and "
+        "MuJoCo's `connect` is soft (its gap stays at 6-8 mm at the finer steps), where the "
+        "position-level joint of Impetus stays at 1e-10 m.",
+    "t_handle":
+        "Each engine's own integrator drifts at first order in dt: over 20 s at 1/1000 s the angular momentum "
+        "by 0.9 % (Bullet, MuJoCo) and 1.4 % (ODE), the energy by 1.7-3 %, 4-10 times more at 1/100 s; none "
+        "keeps L to 1e-6 as the `momentum` integrator does by construction.",
+    "bracket":
+        "Not run in any peer: the bracket is a non-convex triangle mesh (MuJoCo collides a mesh as its convex "
+        "hull, Bullet needs GImpact for a moving concave mesh, ODE's trimesh is another contact model).",
+}
+
 WHY = {
     ("billiards", "mirtich"):
         "The sequential method resolves one contact at a time. Ball 1 touches balls 2 and 3 "
@@ -161,9 +240,9 @@ def fmt_time(t):
     return "%.3g ns" % (t / 1e-9)
 
 
-def default_run(scenario, method, integrator):
+def default_run(scenario, method, integrator, runs=None):
     """The run the atlas judges: the method at the reference step, default caps."""
-    for r in scenario["runs"]:
+    for r in scenario["runs"] if runs is None else runs:
         if r["method"] != method or r["integrator"] != integrator or r["cap"] is not None:
             continue
         if scenario["kind"] == "simulation" and not math.isclose(r["dt"], scenario["reference_dt"]):
@@ -177,11 +256,12 @@ def failing_measures(scenario, run):
     return [k for k, b in bounds.items() if run["errors"].get(k) is None or not run["errors"][k] <= b]
 
 
-def dt_summary(scenario, method, integrator):
+def dt_summary(scenario, method, integrator, runs=None):
     """Which steps the method passes at (default caps), e.g. 'dt <= 1/120'."""
     if scenario["kind"] != "simulation":
         return ""
-    runs = [r for r in scenario["runs"] if r["method"] == method and r["integrator"] == integrator
+    runs = [r for r in (scenario["runs"] if runs is None else runs)
+            if r["method"] == method and r["integrator"] == integrator
             and r["cap"] is None and r["status"] != "unsupported"]
     if len(runs) < 2:
         return ""
@@ -197,8 +277,8 @@ def dt_summary(scenario, method, integrator):
     return "dt " + ", ".join(r["dt_label"] for r in passing)
 
 
-def cell(scenario, method, integrator):
-    run = default_run(scenario, method, integrator)
+def cell(scenario, method, integrator, runs=None):
+    run = default_run(scenario, method, integrator, runs)
     if run is None:
         return "—"
     if run["status"] == "unsupported":
@@ -217,12 +297,15 @@ def cell(scenario, method, integrator):
         if run["status"] == "budget":
             text += " (stopped at %.3g s)" % run["simulated_s"]
     hits = run["counters"]["non_converged"]
-    if hits and scenario["kind"] == "simulation":
+    if run.get("peer"):  # an engine's own failure reports (ODE LCP messages, MuJoCo buffer warnings)
+        if hits:
+            text += " · %d solver failure%s reported" % (hits, "s" if hits > 1 else "")
+    elif hits and scenario["kind"] == "simulation":
         text += " · cap hit in %d of %d steps" % (hits, run["steps"]) if hits <= run["steps"] else \
             " · cap hit %d times" % hits
     elif hits:
         text += " · cap hit"
-    summary = dt_summary(scenario, method, integrator)
+    summary = dt_summary(scenario, method, integrator, runs)
     return text + (" · " + summary if summary else "")
 
 
@@ -241,10 +324,12 @@ def atlas(suite):
     out("# Stability atlas")
     out("")
     out("Generated by `scripts/accuracy.py` from one run of the accuracy suite (`bench_accuracy%s`, %s, "
-        "%s build, %d cores; every run's data in `docs/data/accuracy.json`). Do not edit by hand: "
-        "`bench_accuracy --out docs/data/accuracy.json && python3 scripts/accuracy.py "
-        "docs/data/accuracy.json docs`." % (" --quick" if suite["quick"] else "", suite["generated_utc"][:10],
-                                            suite["build_type"], suite["cores"]))
+        "%s build, %d cores; every run's data in `docs/data/accuracy.json`%s). Do not edit by hand: "
+        "`bench_accuracy --out docs/data/accuracy.json%s && python3 scripts/accuracy.py "
+        "docs/data/accuracy.json docs`." % (
+            " --quick" if suite["quick"] else "", suite["generated_utc"][:10], suite["build_type"], suite["cores"],
+            ", the peers' in `docs/data/accuracy_peers.json`" if suite.get("peers") else "",
+            " && bench_accuracy_peers --out docs/data/accuracy_peers.json" if suite.get("peers") else ""))
     out("")
     out("Each cell judges one method against the scenario's criterion (below the table) at the scenario's "
         "reference setting: the resolver columns with the `momentum` integrator, the integrator columns "
@@ -267,10 +352,8 @@ def atlas(suite):
         out("| [%s](#%s)%s | %s | %s |" % (s["title"], s["id"].replace(".", ""), ref, md(s["criterion"]),
                                            " | ".join(cells)))
     out("")
-    groups = []
-    for s in suite["scenarios"]:
-        if s["group"] not in groups:
-            groups.append(s["group"])
+    if suite.get("peers"):
+        lines.extend(peer_table(suite))
     for s in suite["scenarios"]:
         out("## %s" % s["id"])
         out("")
@@ -281,8 +364,8 @@ def atlas(suite):
                 s["measures"], md(s["criterion"]), s["group"], s["group"]))
         out("")
         errors = list(s["errors"].keys())
-        out("| method | integrator | dt | cap | status | time/step | rounds/step (max) | cap hits | "
-            + " | ".join(errors) + " | pass |")
+        out("| method | integrator | dt | cap | status | time/step | rounds/step (max) | cap hits%s | "
+            % (" (engines: failures reported)" if s.get("peer_runs") else "") + " | ".join(errors) + " | pass |")
         out("|---|---|---|---|---|---|---|---|" + "---|" * len(errors) + "---|")
         unsupported = set()
         for r in s["runs"]:
@@ -298,6 +381,15 @@ def atlas(suite):
                 r["method"], r["integrator"] if s["kind"] == "simulation" else "—", r["dt_label"] or "—", cap,
                 r["status"], fmt_time(r["time_per_step_s"]), r["counters"]["max_rounds_per_step"],
                 r["counters"]["non_converged"], " | ".join(fmt(r["errors"].get(e)) for e in errors), "✅" if r["pass"] else "❌"))
+        for r in s.get("peer_runs", []):
+            if r["status"] == "unsupported":  # at every time step
+                out("| %s | engine's own | any | — | unsupported: %s |%s" % (
+                    r["method"], md(r["message"].split(": ", 1)[-1]), " |" * (4 + len(errors))))
+                continue
+            out("| %s | engine's own | %s | — | %s | %s | — | %s | %s | %s |" % (
+                r["method"], r["dt_label"] or "—", r["status"], fmt_time(r["time_per_step_s"]),
+                r["counters"]["non_converged"] or "—", " | ".join(fmt(r["errors"].get(e)) for e in errors),
+                "✅" if r["pass"] else "❌"))
         out("")
         failing = failing_columns(s)
         if failing:
@@ -311,6 +403,10 @@ def atlas(suite):
         else:
             out("Every method passes at its reference setting.")
             out("")
+        if s.get("peer_runs"):
+            note = PEER_NOTES.get(s["id"]) or PEER_NOTES.get(s["group"])
+            out("**Peers** (%s): %s" % (peer_verdict(s), note or "no comment recorded yet; see the rows above."))
+            out("")
         off_reference = [r for r in s["runs"] if s["kind"] == "simulation" and r["cap"] is None and not r["pass"]
                          and r["status"] == "ok" and not math.isclose(r["dt"], s["reference_dt"])]
         if off_reference and s["id"] in DT_NOTES:
@@ -319,6 +415,66 @@ def atlas(suite):
                                   for r in off_reference})), DT_NOTES[s["id"]]))
             out("")
     return "\n".join(lines) + "\n"
+
+
+def peer_labels(suite):
+    """The peer settings of the peers' run, Bullet, ODE, MuJoCo first (PEER_COLORS order)."""
+    labels = list(suite["peers"].get("settings", {}).keys())
+    return [label for label in PEER_COLORS if label in labels] + sorted(set(labels) - set(PEER_COLORS))
+
+
+def peer_verdict(s):
+    """'Bullet SI 10 ✅, ODE dWorldStep ❌, …' at the reference setting."""
+    parts = []
+    for r in s["peer_runs"]:
+        if s["kind"] == "simulation" and r["status"] != "unsupported" and \
+                not math.isclose(r["dt"], s["reference_dt"]):
+            continue
+        title = PEER_TITLES.get(r["method"], r["method"])
+        mark = "n/a" if r["status"] == "unsupported" else ("✅" if r["pass"] else "❌")
+        parts.append("%s %s" % (title, mark))
+    return ", ".join(parts)
+
+
+def peer_table(suite):
+    """The atlas's second table: every scenario run in Bullet, ODE and MuJoCo."""
+    peers = suite["peers"]
+    labels = peer_labels(suite)
+    lines = []
+    out = lines.append
+    out("## Peers: Bullet, ODE and MuJoCo on the same scenarios")
+    out("")
+    out("From `docs/data/accuracy_peers.json` (`bench_accuracy_peers%s`, %s; %s). Each scenario's scene is "
+        "loaded and built by Impetus exactly as in the suite, then translated into the engine: the same bodies, "
+        "masses, inertias, shapes, initial state and joints, frictionless, the scene's restitution. The engine "
+        "steps it with the same time step for the same duration, and the suite's own probes judge the engine's "
+        "body states (positions, rotations, velocities; contacts found by the Impetus detector at those "
+        "positions), never what the engine reports about itself. Impacts are the suite's one-resolution "
+        "experiment: one engine step from the initial state with gravity off, its velocities judged at the "
+        "initial positions. Time per step is the median wall time of the engine's whole step (its own collision "
+        "detection, solve and integration), where the Impetus impact cells time detection + resolution. Cells "
+        "read as in the table above, at the reference time step; `· n solver failures reported` counts the "
+        "engine's own reports (ODE's LCP messages, MuJoCo's buffer warnings). Per-scenario rows and one sentence "
+        "on each follow in the scenario sections; the charts carry the peers as extra marker shapes. "
+        "`benchmarks/peers/README.md` documents the translation." % (
+            " --quick" if peers.get("quick") else "", peers.get("generated_utc", "?")[:10],
+            ", ".join(peers.get("engines", []))))
+    out("")
+    for label in labels:
+        out("- `%s` (%s): %s." % (label, PEER_TITLES.get(label, label), peers["settings"][label]))
+    out("")
+    out("| scenario | " + " | ".join(PEER_TITLES.get(label, label) for label in labels) + " |")
+    out("|---|" + "---|" * len(labels))
+    for s in suite["scenarios"]:
+        runs = s.get("peer_runs", [])
+        cells = []
+        for label in labels:
+            unsupported = next((r for r in runs if r["method"] == label and r["status"] == "unsupported"), None)
+            cells.append("n/a (unsupported)" if unsupported else cell(s, label, "engine", runs))
+        ref = " (dt %s)" % s["reference_dt_label"] if s["kind"] == "simulation" else ""
+        out("| [%s](#%s)%s | %s |" % (s["title"], s["id"].replace(".", ""), ref, " | ".join(cells)))
+    out("")
+    return lines
 
 
 def failing_columns(s):
@@ -357,7 +513,7 @@ def pareto(points):
 
 def plot_scenario(ax, s, compact=False):
     xs, ys = [], []
-    for r in s["runs"]:
+    for r in s["runs"] + s.get("peer_runs", []):
         if r["status"] not in ("ok", "budget") or not r["time_per_step_s"]:
             continue
         y = r["errors"].get(s["primary"])
@@ -367,8 +523,13 @@ def plot_scenario(ax, s, compact=False):
         xs.append(x)
         ys.append(y)
         filled = r["cap"] is None and r["status"] == "ok"
-        color = COLORS.get(r["method"], "gray")
-        ax.scatter([x], [y], marker=MARKERS.get(r["integrator"], "o"), s=30 if compact else 40,
+        if r.get("peer"):
+            color = PEER_COLORS.get(r["method"], "gray")
+            marker = PEER_MARKERS.get(r["engine"], "x")
+        else:
+            color = COLORS.get(r["method"], "gray")
+            marker = MARKERS.get(r["integrator"], "o")
+        ax.scatter([x], [y], marker=marker, s=30 if compact else 40,
                    facecolors=color if filled else "none", edgecolors=color, linewidths=1.2, zorder=3)
         if not compact and (r["dt_label"] or r["cap"]):
             label = r["dt_label"] + (" cap %d" % r["cap"] if r["cap"] else "")
@@ -411,23 +572,38 @@ def widen(set_limits, lo, hi, ratio):
     set_limits(lo, hi)
 
 
-def legend(fig):
+def legend(fig, peers=()):
     from matplotlib.lines import Line2D
     handles = [Line2D([], [], marker="o", linestyle="", color=c, label=m) for m, c in COLORS.items()]
     handles += [Line2D([], [], marker=MARKERS[i], linestyle="", markerfacecolor="none", color="black",
                        label="integrator " + i) for i in INTEGRATORS]
+    handles += [Line2D([], [], marker=PEER_MARKERS[label.split("/")[0]], linestyle="",
+                       color=PEER_COLORS.get(label, "gray"), label=PEER_TITLES.get(label, label)) for label in peers]
     handles += [Line2D([], [], marker="o", linestyle="", markerfacecolor="none", color="gray",
                        label="capped / stopped at budget"),
                 Line2D([], [], linestyle="--", color="black", label="Pareto front"),
                 Line2D([], [], linestyle=":", color="#d62728", label="criterion"),
                 Line2D([], [], linestyle="-.", color="#999999", label="error 0 (drawn at 1e-17)")]
-    fig.legend(handles=handles, loc="lower center", ncol=5, fontsize=7, frameon=False)
+    fig.legend(handles=handles, loc="lower center", ncol=6 if peers else 5, fontsize=7, frameon=False)
 
 
 def save(fig, path):
     fig.savefig(path + ".png", dpi=110, metadata={"Software": None})
     fig.savefig(path + ".svg", metadata={"Date": None, "Creator": None})
     plt.close(fig)
+
+
+def peers_in(scenarios):
+    """The peer settings with at least one point on these scenarios' charts, in PEER_COLORS order."""
+    seen = {r["method"] for s in scenarios for r in s.get("peer_runs", []) if r["status"] in ("ok", "budget")}
+    return [label for label in PEER_COLORS if label in seen] + sorted(seen - set(PEER_COLORS))
+
+
+def legend_space(fig, peers):
+    """Fraction of the figure's height below the plots for the legend (rows of 5 or 6 entries)."""
+    entries = 9 + len(peers)
+    rows = (entries + (6 if peers else 5) - 1) // (6 if peers else 5)
+    return min(0.4, (0.2 + 0.2 * rows) / fig.get_size_inches()[1])
 
 
 def charts(suite, chart_dir):
@@ -445,8 +621,9 @@ def charts(suite, chart_dir):
             plot_scenario(ax, s)
         for ax in list(axes.flat)[n:]:
             ax.axis("off")
-        legend(fig)
-        fig.tight_layout(rect=(0, 0.09 if rows == 1 else 0.05, 1, 1))
+        peers = peers_in(members)
+        legend(fig, peers)
+        fig.tight_layout(rect=(0, legend_space(fig, peers), 1, 1))
         path = os.path.join(chart_dir, "accuracy_" + group)
         save(fig, path)
         written.append(path)
@@ -458,29 +635,51 @@ def charts(suite, chart_dir):
             plot_scenario(ax, s, compact=True)
         for ax in list(axes.flat)[len(chosen):]:
             ax.axis("off")
-        fig.suptitle("Impetus: speed against accuracy (time per step vs error, log-log; Pareto front dashed)",
-                     fontsize=10)
-        legend(fig)
-        fig.tight_layout(rect=(0, 0.06, 1, 0.97))
+        peers = peers_in(chosen)
+        fig.suptitle("Impetus%s: speed against accuracy (time per step vs error, log-log; Pareto front dashed)"
+                     % (" and its peers" if peers else ""), fontsize=10)
+        legend(fig, peers)
+        fig.tight_layout(rect=(0, legend_space(fig, peers), 1, 0.97))
         path = os.path.join(chart_dir, "accuracy_overview")
         save(fig, path)
         written.append(path)
     return written
 
 
+def merge_peers(suite, peers):
+    """The peers' runs as `peer_runs` of the suite's scenarios with the same id; their header as `peers`."""
+    by_id = {s["id"]: s for s in peers["scenarios"]}
+    for s in suite["scenarios"]:
+        if s["id"] in by_id:
+            s["peer_runs"] = by_id[s["id"]]["runs"]
+    suite["peers"] = {k: v for k, v in peers.items() if k != "scenarios"}
+
+
 def main(argv):
-    if len(argv) != 3:
-        sys.exit("usage: accuracy.py SUITE.json DOCS_DIR")
+    if len(argv) not in (3, 4):
+        sys.exit("usage: accuracy.py SUITE.json DOCS_DIR [PEERS.json]")
     with open(argv[1]) as f:
         suite = json.load(f)
+    peers_path = argv[3] if len(argv) == 4 else os.path.join(os.path.dirname(argv[1]), "accuracy_peers.json")
+    if os.path.exists(peers_path):
+        with open(peers_path) as f:
+            peers = json.load(f)
+        if peers.get("quick") != suite.get("quick"):  # e.g. a full peers file left beside a quick suite
+            print("accuracy.py: %s is a %s run and the suite a %s one: peers left out" % (
+                peers_path, "quick" if peers.get("quick") else "full", "quick" if suite.get("quick") else "full"))
+        else:
+            merge_peers(suite, peers)
+    elif len(argv) == 4:
+        sys.exit("accuracy.py: %s not found" % peers_path)
     plt.rcParams["svg.hashsalt"] = "impetus-accuracy"
     docs = argv[2]
     os.makedirs(docs, exist_ok=True)
     with open(os.path.join(docs, "stability.md"), "w") as f:
         f.write(atlas(suite))
     written = charts(suite, os.path.join(docs, "charts"))
-    print("accuracy.py: wrote %s and %d charts (png + svg) in %s" % (
-        os.path.join(docs, "stability.md"), len(written), os.path.join(docs, "charts")))
+    print("accuracy.py: wrote %s and %d charts (png + svg) in %s%s" % (
+        os.path.join(docs, "stability.md"), len(written), os.path.join(docs, "charts"),
+        " with the peers of " + peers_path if suite.get("peers") else " (no peers merged)"))
 
 
 if __name__ == "__main__":

@@ -44,5 +44,11 @@ if [ -x "$build/bin/bench_accuracy" ]; then
   accuracy_args=()
   [ $quick = 1 ] && accuracy_args+=(--quick)
   "$build/bin/bench_accuracy" "${accuracy_args[@]}" --out "$data/accuracy.json"
+  # The same scenarios in Bullet, ODE and MuJoCo (built only when one is installed); accuracy.py merges
+  # accuracy_peers.json found beside accuracy.json.
+  if [ -x "$build/bin/bench_accuracy_peers" ]; then
+    echo "== bench_accuracy_peers"
+    "$build/bin/bench_accuracy_peers" "${accuracy_args[@]}" --out "$data/accuracy_peers.json"
+  else rm -f "$data/accuracy_peers.json"; fi
   "$py" "$root/scripts/accuracy.py" "$data/accuracy.json" "$root/docs"
 fi

@@ -10,6 +10,7 @@
 //   stiff     the hardest MuJoCo allows: solimp 0.9999 (its clamp mjMAXIMP) everywhere, and solref in the
 //             direct form "0 −1/dt" (stiffness 0: no position term; damping 1/dt: a_ref·dt = −v, so a hard
 //             contact would stop exactly in one step).
+#include "mujoco_support.hpp"
 #include "peers.hpp"
 
 #include <mujoco/mujoco.h>
@@ -69,26 +70,12 @@ std::string make_mjcf(const bench::PreparedScene& scene, const StepSettings& set
   return x.str();
 }
 
-mjModel* load_model(const std::string& xml) {
-  mjVFS vfs;
-  mj_defaultVFS(&vfs);
-  const char* name = "peers.xml";
-  if (mj_makeEmptyFileVFS(&vfs, name, static_cast<int>(xml.size())) != 0) throw std::runtime_error("MuJoCo VFS full");
-  const int file = mj_findFileVFS(&vfs, name);
-  std::copy(xml.begin(), xml.end(), static_cast<char*>(vfs.filedata[file]));
-  char error[1000] = "";
-  mjModel* model = mj_loadXML(name, &vfs, error, sizeof error);
-  mj_deleteVFS(&vfs);
-  if (!model) throw std::runtime_error(std::string("MuJoCo: ") + error);
-  return model;
-}
-
 class MujocoStep final : public PeerStep {
  public:
   MujocoStep(const bench::PreparedScene& scene, const StepSettings& settings, const MujocoConfig& config)
       : scene_(scene), settings_(settings), pairs_(scene.contacts) {
     mjcb_time = &steady_seconds;
-    model_ = load_model(make_mjcf(scene, settings, config));
+    model_ = load_mjcf(make_mjcf(scene, settings, config));
     model_->opt.solver = config.solver;
     model_->opt.iterations = config.iterations;
     model_->opt.tolerance = config.tolerance;

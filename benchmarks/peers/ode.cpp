@@ -6,40 +6,18 @@
 // mu = 0, bounce = e with bounce_vel 0 for e > 0, world CFM as configured (contacts use it: no
 // dContactSoftCFM). ODE's LCP errors ("LCP internal error, s <= 0") arrive through dMessage: a handler
 // counts them as failures.
+#include "ode_support.hpp"
 #include "peers.hpp"
 
 #include <ode/ode.h>
 
 #include <chrono>
-#include <cstdarg>
 #include <cstdint>
 #include <cstdio>
-#include <cstdlib>
 #include <deque>
 
 namespace impetus::peers {
 namespace {
-
-/// ODE messages (not errors) during a step: the Dantzig LCP's "LCP internal error, s <= 0" and similar.
-/// PEERS_ODE_VERBOSE=1 prints them (ODE's own handler would print every one to stderr).
-int g_ode_messages = 0;
-void count_message(int number, const char* format, va_list args) {
-  ++g_ode_messages;
-  if (!std::getenv("PEERS_ODE_VERBOSE")) return;
-  std::fprintf(stderr, "ODE message %d: ", number);
-  std::vfprintf(stderr, format, args);
-  std::fprintf(stderr, "\n");
-}
-
-void init_ode() {
-  static const bool done = [] {
-    dInitODE2(0);
-    dAllocateODEDataForThread(dAllocateMaskAll);
-    dSetMessageHandler(&count_message);
-    return true;
-  }();
-  (void)done;
-}
 
 struct OdeConfig {
   bool quick = false;       ///< dWorldQuickStep, else dWorldStep
@@ -85,7 +63,7 @@ class OdeStep final : public PeerStep {
       dBodySetForce(bodies_[i], 0, 0, 0);
       dBodySetTorque(bodies_[i], 0, 0, 0);
     }
-    g_ode_messages = 0;
+    ode_messages() = 0;
   }
 
   void step() override {
@@ -117,7 +95,7 @@ class OdeStep final : public PeerStep {
     }
     tally.finish(r);
     r.iterations = config_.quick ? config_.iterations : 0;
-    r.failures = g_ode_messages;
+    r.failures = ode_messages();
     r.solver_seconds = steps_ ? solver_seconds_ / steps_ : kNaN;
     return r;
   }
