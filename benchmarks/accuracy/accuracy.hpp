@@ -24,7 +24,7 @@ namespace impetus::accuracy {
 struct Method {
   std::string resolver = "ledas";        ///< plugin: "ledas" or "mirtich"
   std::string mode = "complementary";    ///< ledas: "complementary" or "paper"; empty for mirtich
-  std::string integrator = "momentum";   ///< "euler" (the paper's eq. 2) or "momentum"
+  std::string integrator = "momentum";   ///< "euler" (the paper's eq. 2), "momentum" or "splitting"
   double dt = 0.0;                       ///< time step (s); 0 keeps the scene's (impact scenarios)
   long long cap = 0;                     ///< ledas `max_rounds`, mirtich `max_impulses`; 0 = default
 
@@ -60,11 +60,11 @@ enum class Kind {
   simulation  ///< `duration` seconds of steps
 };
 
-/// Where a simulation scenario runs the paper's integrator (`euler`) besides `momentum`.
+/// Where a simulation scenario runs the paper's integrator (`euler`) and `splitting` besides `momentum`.
 enum class IntegratorSweep {
   none,       ///< momentum only (the integrator plays no part)
-  reference,  ///< euler at the reference step only (it matters little: resting bodies hardly turn)
-  every_dt    ///< euler at every step swept
+  reference,  ///< euler and splitting at the reference step only (resting bodies hardly turn)
+  every_dt    ///< euler and splitting at every step swept
 };
 
 /// One scenario: a scene file with overrides, what is measured, and the criterion.
@@ -78,7 +78,7 @@ struct Scenario {
   double duration = 0.0;          ///< simulation: seconds simulated
   double reference_dt = 0.0;      ///< simulation: the step the atlas judges at (s)
   std::vector<double> dts;        ///< simulation: steps swept (s)
-  IntegratorSweep sweep = IntegratorSweep::none;  ///< simulation: where euler is run too
+  IntegratorSweep sweep = IntegratorSweep::none;  ///< simulation: where euler and splitting run too
   std::vector<std::string> resolvers;  ///< resolver labels run ("ledas/complementary", …)
   std::string measures;           ///< what is measured, one sentence
   std::map<std::string, std::string> error_doc;  ///< each error's meaning and unit

@@ -9,7 +9,8 @@ target_include_directories(impetus_accuracy PUBLIC ${_accuracy_dir})
 target_link_libraries(impetus_accuracy PUBLIC impetus_core nlohmann_json::nlohmann_json
                                        PRIVATE impetus_compile_options)
 # Runs load these plugins by name at run time.
-set(IMPETUS_ACCURACY_PLUGINS impetus_integrator_euler impetus_integrator_momentum impetus_detector_fcl
+set(IMPETUS_ACCURACY_PLUGINS impetus_integrator_euler impetus_integrator_momentum impetus_integrator_splitting
+    impetus_detector_fcl
     impetus_resolver_ledas impetus_resolver_mirtich)
 foreach(plugin ${IMPETUS_ACCURACY_PLUGINS})
   if(TARGET ${plugin})

@@ -146,8 +146,10 @@ std::vector<Method> methods_for(const Scenario& scenario, bool quick) {
       const bool euler = scenario.sweep == IntegratorSweep::every_dt ||
                          (scenario.sweep == IntegratorSweep::reference && dt == scenario.reference_dt && !paper_resting);
       if (euler) {
-        m.integrator = "euler";
-        out.push_back(m);
+        for (const char* integrator : {"euler", "splitting"}) {
+          m.integrator = integrator;
+          out.push_back(m);
+        }
       }
     }
     for (const long long cap : caps_of(label)) {
