@@ -37,6 +37,11 @@ export ASAN_OPTIONS=${ASAN_OPTIONS:-halt_on_error=1:detect_leaks=1:abort_on_erro
 export UBSAN_OPTIONS=${UBSAN_OPTIONS:-halt_on_error=1:print_stacktrace=1}
 # Known leaks inside libassimp (fuzz/lsan.supp says which and why).
 export LSAN_OPTIONS=${LSAN_OPTIONS:-suppressions=$root/fuzz/lsan.supp}
+# The mesh targets import through the importer process, as a program does (assets/README.md). Its limits
+# stay below libFuzzer's -timeout (30 s), so an input that makes assimp loop is the importer's clear error,
+# not a fuzzer timeout; its memory is its own, outside -rss_limit_mb.
+export IMPETUS_MESH_IMPORT_TIMEOUT_SECONDS=${IMPETUS_MESH_IMPORT_TIMEOUT_SECONDS:-10}
+export IMPETUS_MESH_IMPORT_CPU_SECONDS=${IMPETUS_MESH_IMPORT_CPU_SECONDS:-5}
 
 run_one() {
   local target=$1 build=$2 root=$3 seconds=$4 seed=$5

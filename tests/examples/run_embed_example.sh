@@ -11,3 +11,6 @@ cmake --build "$work/build" >/dev/null
 "$work/build/embed" "$work/prefix/share/impetus/scenes/demo.yaml"
 "$work/prefix/bin/impetus" plugins | grep -q "$work/prefix/.*impetus_integrator_euler.so" || {
   echo "installed impetus does not find its own plugins" >&2; "$work/prefix/bin/impetus" plugins >&2; exit 1; }
+# Meshes are imported by the importer program, which the relocated library must find in its own prefix.
+mass=$("$work/prefix/bin/impetus" mass "$work/prefix/share/impetus/meshes/cube.obj" 2>&1) || {
+  echo "installed impetus cannot import a mesh: $mass" >&2; exit 1; }

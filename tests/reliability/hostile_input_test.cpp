@@ -287,6 +287,23 @@ std::vector<Row> rows() {
   table.push_back({"mesh_self_intersecting",
                    [] { return load_mesh(source_dir() / "fuzz/regressions/mesh_off/self-intersecting-t-handle.off"); },
                    "the mesh probably intersects itself"});
+  // Inputs that crash assimp 5.2 itself: the importer process takes the crash, the caller gets an error
+  // naming the file and what became of the importer (assets/src/import_process.cpp).
+  table.push_back({"mesh_ply_assimp_abort",
+                   [] {
+                     return load_mesh(source_dir() /
+                                      "fuzz/regressions/mesh_ply/abort-assimp-triangulate-149-sided-faces.ply");
+                   },
+                   "abort-assimp-triangulate-149-sided-faces.ply: the mesh importer (assimp 5.2) crashed with "
+                   "signal 6 (SIGABRT) while reading the file; the file is malformed"});
+  table.push_back({"mesh_dae_assimp_segv",
+                   [] { return load_mesh(source_dir() / "fuzz/regressions/mesh_dae/segv-assimp-null-dereference.dae"); },
+                   "segv-assimp-null-dereference.dae: the mesh importer (assimp 5.2) crashed with signal 11 "
+                   "(SIGSEGV) while reading the file; the file is malformed"});
+  table.push_back({"mesh_glb_assimp_out_of_memory",
+                   [] { return load_mesh(source_dir() / "fuzz/regressions/mesh_glb/oom-assimp-1500-mb-buffer.glb"); },
+                   "oom-assimp-1500-mb-buffer.glb: the mesh importer (assimp 5.2) ran out of memory while reading "
+                   "the file: it needed more than its limit of 1024 MiB"});
   table.push_back({"mesh_with_nan_vertex", [] { return load_mesh(meshes_dir() / "broken" / "nan_cube.obj"); },
                    "not a finite point"});
   table.push_back({"mesh_open", [] { return load_mesh(meshes_dir() / "broken" / "open_cube.obj"); },

@@ -13,6 +13,24 @@
 /// dropped (with a warning), and vertices at identical positions welded (assimp's
 /// aiProcess_JoinIdenticalVertices is not used: it keeps STL's per-facet vertices apart because their
 /// normals differ, and it merges within a tolerance rather than on equality).
+///
+/// Isolation. assimp reads the file in a separate process, `impetus-mesh-import`, found next to
+/// libimpetus_core.so (`<libdir>/impetus/libexec/`, in the build tree and in an installed, relocated
+/// prefix alike). assimp 5.2 can crash, abort or allocate without bound on a malformed file; in that
+/// process this ends the import with an Error naming the file and what happened, never the program.
+/// The process imports under limits, and the library checks everything it sends back. Environment
+/// variables, read at each import:
+/// - `IMPETUS_MESH_IMPORT`: `isolated` (default) or `in-process` (assimp in the calling process: no
+///   process cost, no protection; for debugging);
+/// - `IMPETUS_MESH_IMPORT_MEMORY_MB`: address-space limit (RLIMIT_AS) in MiB; default 1024 MiB plus
+///   16 bytes per byte of the file;
+/// - `IMPETUS_MESH_IMPORT_CPU_SECONDS`: CPU time limit (RLIMIT_CPU); default 60 s;
+/// - `IMPETUS_MESH_IMPORT_TIMEOUT_SECONDS`: wall-clock limit, after which the process is killed;
+///   default 120 s;
+/// - `IMPETUS_MESH_IMPORT_HELPER`: the importer program's path, instead of the default place.
+/// The process costs a few milliseconds per import (assets/README.md). It is started with posix_spawn
+/// (safe in a program with threads, and imports may run concurrently); it is always reaped, its pipes
+/// always closed; the library never writes to it (no SIGPIPE) and resumes interrupted system calls.
 
 #include "impetus/core/shape.hpp"
 
@@ -60,8 +78,10 @@ struct ImportedMesh {
 };
 
 /// Imports `file`. Throws Error("<file>: <problem>") when it cannot be opened, is empty, is a
-/// truncated binary STL, cannot be parsed, or holds no triangles. The mesh is not validated here
-/// (see mesh_validation.hpp).
+/// truncated binary STL, cannot be parsed, or holds no triangles; and, with isolation, when the
+/// importer process crashed (the signal is named), ran out of its memory, CPU time or wall-clock limit,
+/// sent a malformed reply, or cannot be found or started. The mesh is not validated here (see
+/// mesh_validation.hpp). May be called from several threads at once.
 ImportedMesh import_mesh(const std::filesystem::path& file, const ImportOptions& options = {});
 
 /// Welds vertices at exactly equal positions (−0 equals +0; NaN never equals anything), renumbers
