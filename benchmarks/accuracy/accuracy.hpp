@@ -9,6 +9,7 @@
 #include "impetus/core/scene.hpp"
 #include "impetus/core/world.hpp"
 
+#include <chrono>
 #include <cstddef>
 #include <filesystem>
 #include <functional>
@@ -137,5 +138,14 @@ RunResult run_isolated(const Scenario& scenario, const Method& method,
 
 /// "1/60" for 1/60 s and similar round reciprocals, else the number.
 std::string format_dt(double dt);
+
+/// Wall time (s) since `start` on the steady clock every run is timed with.
+double seconds_since(std::chrono::steady_clock::time_point start);
+
+/// The median of `values` (the mean of the two middle ones for an even count); 0 when empty.
+double median(std::vector<double> values);
+
+/// The current time as ISO 8601 UTC ("2026-11-22T03:04:05Z"), for the JSON header.
+std::string utc_now();
 
 }  // namespace impetus::accuracy

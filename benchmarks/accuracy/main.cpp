@@ -86,13 +86,6 @@ bool selected(const Options& o, const Scenario& s) {
   return false;
 }
 
-std::string utc_now() {
-  const std::time_t now = std::time(nullptr);
-  char buffer[32];
-  std::strftime(buffer, sizeof buffer, "%Y-%m-%dT%H:%M:%SZ", std::gmtime(&now));
-  return buffer;
-}
-
 }  // namespace
 
 int main(int argc, char** argv) {

@@ -35,16 +35,6 @@ using namespace impetus::accuracy;
 using namespace impetus::peers::accuracy;
 using Clock = std::chrono::steady_clock;
 
-double seconds_since(Clock::time_point start) { return std::chrono::duration<double>(Clock::now() - start).count(); }
-
-double median(std::vector<double> values) {
-  if (values.empty()) return 0.0;
-  const auto mid = values.begin() + static_cast<std::ptrdiff_t>(values.size() / 2);
-  std::nth_element(values.begin(), mid, values.end());
-  if (values.size() % 2 == 1) return *mid;
-  return 0.5 * (*mid + *std::max_element(values.begin(), mid));
-}
-
 /// The judging world's resolver: applies nothing, only writes the engine's impulses onto the contacts the
 /// Impetus detector found (each engine point goes to the nearest Impetus contact on the same pair of
 /// bodies), so that the probes that read impulses (Figure 2's minimum-norm distance) see the engine's.
@@ -265,13 +255,6 @@ Options parse(int argc, char** argv) {
   }
   if (o.budget <= 0) o.budget = o.quick ? 3.0 : 10.0;
   return o;
-}
-
-std::string utc_now() {
-  const std::time_t now = std::time(nullptr);
-  char buffer[32];
-  std::strftime(buffer, sizeof buffer, "%Y-%m-%dT%H:%M:%SZ", std::gmtime(&now));
-  return buffer;
 }
 
 }  // namespace
