@@ -18,8 +18,13 @@
 /// Complementarity (the complementary mode, the position correction): a proximal-point iteration whose
 /// subproblems have the positive definite matrix A + εI, each solved by block principal pivoting then
 /// the primal active-set method, on a masked sparse LDLᵀ (masked_ldlt.hpp) with one symbolic analysis
-/// per pattern and Schur-complement updates for small changes; exact to 1e-3 · tolerance on the free
-/// rows. No minimum-norm solve inside the loop (the velocities are unique, the impulses are not); a
+/// per pattern and Schur-complement updates for small changes; a larger ε while the active set is
+/// searched, and each candidate free set tried on the problem itself by preconditioned conjugate
+/// gradients; exact to 1e-3 · tolerance on the free rows.
+///
+/// Sources: island_solver.cpp (set-up, caches), equality_solve.cpp (the paper mode's subsets),
+/// complementarity.cpp (the proximal active set), complementarity_fallback.cpp (minimum-norm fallback
+/// and polish). No minimum-norm solve inside the loop (the velocities are unique, the impulses are not); a
 /// minimum-norm polish at the end where the system is small. README.md derives it.
 
 #include <Eigen/Dense>
@@ -50,8 +55,12 @@ struct SolverSettings {
   double rank_tolerance = 1e-10;  ///< a pivot or eigenvalue ≤ this × max A_ii counts as zero
   std::size_t update_limit = 8;  ///< sparse path: largest active-set change solved by an update
   std::uint64_t max_iterations = 10000;  ///< active-set iterations per complementarity problem
-  /// Complementarity problems: proximal regularization ε = this × max A_kk (solve_complementarity).
+  /// Complementarity problems: proximal regularization ε = this × max A_kk (solve_complementarity): the
+  /// first solve's and the final one.
   double regularization = 1e-10;
+  /// Complementarity problems: the larger ε = this × max A_kk of the active-set search once the start set
+  /// turned out not to be the answer (solve_complementarity); at most `regularization` disables it.
+  double search_regularization = 1e-3;
 };
 
 /// What the solver did, accumulated over calls (reset by the caller).
@@ -73,6 +82,7 @@ struct SolverStats {
   std::uint64_t nan_caught = 0;   ///< systems whose solution was not finite (zero returned)
   std::uint64_t polished = 0;     ///< complementarity solutions replaced by the minimum-norm split
   std::uint64_t proximal = 0;     ///< proximal outer iterations after the first
+  std::uint64_t refinements = 0;  ///< conjugate-gradient steps of exact solves on a candidate free set
 };
 
 /// One island's complementarity problem: find p with w = A p − c and
@@ -104,10 +114,12 @@ class IslandSolver {
   void solve_subset(const SparseMatrix& a, const Vector& c, std::span<const RowIndex> subset, Vector& p,
                     SolverStats& stats);
 
-  /// Solves the complementarity problem (island_solver.cpp, README.md): proximal-point outer iterations
-  /// on ½ pᵀ(A + εI) p − (c + ε p̄)ᵀp, ε = regularization · max A_kk, each subproblem by block principal
-  /// pivoting while the number of infeasible rows falls, then the primal active-set method (monotone:
-  /// it terminates), started from the given set. Returns p with p ≥ 0 on inequality rows, w ≥ −tolerance
+  /// Solves the complementarity problem (complementarity.cpp, README.md): proximal-point outer iterations
+  /// on ½ pᵀ(A + εI) p − (c + ε p̄)ᵀp, ε = regularization · max A_kk for the first solve and
+  /// search_regularization · max A_kk while the active set is searched, each subproblem by block
+  /// principal pivoting while the number of infeasible rows falls, then the primal active-set method
+  /// (monotone: it terminates), started from the given set; each solved subproblem's free set F is tried
+  /// on the problem itself (A_FF p = c_F by preconditioned conjugate gradients). Returns p with p ≥ 0 on inequality rows, w ≥ −tolerance
   /// and |w| ≤ 1e-3 · tolerance on the rows with p ≠ 0; the minimum-norm split where the final system has
   /// at most polish_limit rows and that split is ≥ 0. Conflicting targets (no exact solution): the
   /// minimum-norm least-squares active set of solve_complementarity_min_norm.
@@ -125,23 +137,34 @@ class IslandSolver {
     double floor = 0.0;               // A_kk at or below this: nothing movable behind row k
     bool singular = false;            // a factorization met a redundant row (pivot ≈ the shift)
     std::vector<char> in_base;        // rows of the last factorization (free and not dropped)
+    // The last Schur-complement update (solve_updated): the free set it solves for, its border
+    // columns U, Y = F⁻¹U and the factorized Schur system; reused while the free set stays.
+    bool updated = false;
+    std::vector<char> updated_for;
+    std::vector<RowIndex> added, removed;
+    Eigen::MatrixXd columns, borders;
+    Eigen::FullPivLU<Eigen::MatrixXd> schur;
   };
   struct Workspace {  // reused buffers (no allocation per round once warm)
-    std::vector<RowIndex> added, removed;  // update path
-    Eigen::MatrixXd columns, borders;
     std::vector<int> slot, parent, start, fill, members;  // subset components
     Eigen::MatrixXd dense;
     Vector rhs;
+    Vector residual, preconditioned, direction, product;  // refine_on_free_set
+    std::vector<char> solved_rows;
   };
 
   Vector solve_active(const SparseMatrix& a, double shift, const Vector& r, const std::vector<char>& active,
                       ActiveLoop& loop, SolverStats& stats);
+  enum class Refinement { exact, infeasible, not_converged };
+  Refinement refine_on_free_set(const SparseMatrix& a, const Vector& c, double shift, const std::vector<char>& free_rows,
+                                ActiveLoop& loop, const ComplementarityProblem& problem, Vector& x, SolverStats& stats);
   Vector solve_complementarity_min_norm(const ComplementarityProblem& problem, SolverStats& stats);
   Vector solve_system(const SparseMatrix& m, const Vector& rhs, SolverStats& stats);
   Vector solve_dense_matrix(const Eigen::MatrixXd& a, const Vector& rhs, SolverStats& stats);
   Vector solve_sparse(const SparseMatrix& m, const Vector& rhs, double pivot_floor, SolverStats& stats);
-  bool solve_updated(const ActiveLoop& loop, const SparseMatrix& a, double shift, const Vector& c,
+  bool solve_updated(ActiveLoop& loop, const SparseMatrix& a, double shift, const Vector& c,
                      const std::vector<char>& active, Vector& p, SolverStats& stats);
+  static void apply_update(const ActiveLoop& loop, const Vector& c, Vector& out);
   void polish_minimum_norm(const SparseMatrix& a, const Vector& c, std::vector<char> rows,
                            const ComplementarityProblem& problem, Vector& p, SolverStats& stats);
   FactorPtr checkout(const SparseMatrix& m, SolverStats& stats);

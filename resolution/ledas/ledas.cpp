@@ -148,6 +148,8 @@ LedasSettings LedasSettings::from_options(const ModuleOptions& options) {
   s.solver.update_limit = static_cast<std::size_t>(
       options.integer("update_limit", static_cast<long long>(s.solver.update_limit), 0, 10'000));
   s.solver.regularization = options.number("regularization", s.solver.regularization, 1e-16, 1e-2);
+  s.solver.search_regularization =
+      options.number("search_regularization", s.solver.search_regularization, 0.0, 1e-1);
   s.solver.max_iterations = s.max_rounds;
   s.islands = options.boolean("islands", s.islands);
   s.resting = resolution::RestingSettings::from_options(options);

@@ -1,0 +1,153 @@
+// Complementarity problems: the two minimum-norm pieces around the proximal active set of
+// complementarity.cpp — the fallback for problems without an exact solution, and the minimum-norm
+// impulse split of a small final system.
+#include "ledas/island_solver.hpp"
+#include "ledas/solver_internal.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+namespace impetus::ledas {
+
+// The earlier method, kept as the fallback for problems the proximal iteration cannot finish (an
+// inconsistent singular system: conflicting targets, where the regularized iterates drift): each free
+// set solved by minimum-norm least squares, whose residual is then a null direction followed to the
+// first bound.
+Vector IslandSolver::solve_complementarity_min_norm(const ComplementarityProblem& problem, SolverStats& stats) {
+  const SparseMatrix& a = *problem.matrix;
+  const auto m = static_cast<std::size_t>(a.rows());
+  const Vector& c = problem.rhs;
+  const auto inequality = [&](std::size_t k) { return !problem.equality[k]; };
+  std::vector<char> free_rows(m);
+  for (std::size_t k = 0; k < m; ++k) free_rows[k] = problem.equality[k] || problem.start[k];
+  Vector p = Vector::Zero(a.rows());
+  bool converged = false, not_finite = false, infeasible = false;
+  for (std::uint64_t iteration = 0; iteration < settings_.max_iterations; ++iteration) {
+    ++stats.iterations;
+    const std::uint64_t singular_before = stats.singular;
+    const std::vector<RowIndex> rows = members(free_rows);
+    Vector z = Vector::Zero(a.rows());
+    {
+      const Vector part = solve_system(principal_submatrix(a, rows), gather(c, rows), stats);
+      for (std::size_t i = 0; i < rows.size(); ++i) z(rows[i]) = part(static_cast<Eigen::Index>(i));
+    }
+    const bool singular = stats.singular != singular_before;
+    if (!z.allFinite()) {
+      ++stats.nan_caught;
+      p.setZero();
+      not_finite = true;
+      break;
+    }
+    // A singular system with an inconsistent right-hand side has no minimizer on F: the objective falls
+    // without bound along the residual d = c − A z (a null direction). Follow it to the first bound.
+    Vector d = c - a * z;
+    double inconsistency = 0.0;
+    for (std::size_t k = 0; k < m; ++k)
+      if (free_rows[k]) inconsistency = std::max(inconsistency, std::abs(d(static_cast<Eigen::Index>(k))));
+      else d(static_cast<Eigen::Index>(k)) = 0.0;
+    bool along_null = singular && inconsistency > 0.5 * problem.tolerance;
+    if (along_null) {  // keep d's clear components; if none is on an inequality row, z is the answer on F
+      along_null = false;
+      for (std::size_t k = 0; k < m; ++k) {
+        double& dk = d(static_cast<Eigen::Index>(k));
+        if (std::abs(dk) < 1e-6 * inconsistency) dk = 0.0;
+        along_null = along_null || (inequality(k) && dk != 0.0);
+      }
+    }
+    Vector direction;  // p moves along `direction` by the ratio test, or p = z
+    const double roundoff = kImpulseRoundoff * z.lpNorm<Eigen::Infinity>();
+    if (along_null) {
+      direction = d;
+    } else {
+      bool feasible = true;
+      for (std::size_t k = 0; k < m; ++k)
+        if (free_rows[k] && inequality(k) && z(static_cast<Eigen::Index>(k)) < -roundoff) feasible = false;
+      if (!feasible) direction = z - p;
+    }
+    if (direction.size() > 0) {
+      // Ratio test: the largest step keeping every free inequality row ≥ 0.
+      double step = std::numeric_limits<double>::infinity();
+      std::size_t blocking = m;
+      for (std::size_t k = 0; k < m; ++k) {
+        const auto i = static_cast<Eigen::Index>(k);
+        if (!free_rows[k] || !inequality(k) || !(direction(i) < 0.0)) continue;
+        const double ratio = std::max(0.0, p(i)) / -direction(i);
+        if (ratio < step) step = ratio, blocking = k;
+      }
+      if (blocking == m) {  // the objective falls without bound: the problem has no solution
+        infeasible = true;
+        ++stats.infeasible;
+        break;
+      }
+      if (!along_null) step = std::min(step, 1.0);
+      p += step * direction;
+      const double floor = kImpulseRoundoff * p.lpNorm<Eigen::Infinity>();
+      for (std::size_t k = 0; k < m; ++k) {
+        const auto i = static_cast<Eigen::Index>(k);
+        const bool falling = along_null ? direction(i) < 0.0 : z(i) < -roundoff;
+        if (free_rows[k] && inequality(k) && (k == blocking || (falling && p(i) <= floor))) {
+          free_rows[k] = 0;
+          p(i) = 0.0;
+          ++stats.released;
+        }
+      }
+      continue;
+    }
+    p = z;
+    // Add every row at zero that would approach.
+    const Vector w = a * p - c;
+    bool added = false;
+    for (std::size_t k = 0; k < m; ++k) {
+      const auto i = static_cast<Eigen::Index>(k);
+      if (inequality(k) && free_rows[k]) p(i) = std::max(p(i), 0.0);  // rounding below zero
+      if (!free_rows[k] && w(i) < -problem.tolerance) {
+        free_rows[k] = 1;
+        added = true;
+        ++stats.added;
+      }
+    }
+    if (!added) {
+      converged = true;
+      break;
+    }
+  }
+  if (!converged && !not_finite && !infeasible) ++stats.non_converged;
+  for (std::size_t k = 0; k < m; ++k)
+    if (inequality(k)) p(static_cast<Eigen::Index>(k)) = free_rows[k] ? std::max(p(static_cast<Eigen::Index>(k)), 0.0) : 0.0;
+  return p;
+}
+
+// The redundant rows' share of the impulse is not unique; where the system is small enough to afford
+// it, take the minimum-norm one (the paper's choice for its Figure 2: the impulse shared equally among
+// collinear contacts) if it keeps every impulse ≥ 0. It changes no velocity: p − p_min is a
+// self-equilibrated impulse set (A (p − p_min) = 0).
+void IslandSolver::polish_minimum_norm(const SparseMatrix& a, const Vector& c, std::vector<char> rows,
+                                       const ComplementarityProblem& problem, Vector& p, SolverStats& stats) {
+  for (std::size_t k = 0; k < rows.size(); ++k)  // rows at zero with w = 0 may share the impulse too
+    if (!rows[k] && !problem.equality[k]) {
+      double w = -c(static_cast<Eigen::Index>(k));
+      for (SparseMatrix::InnerIterator it(a, static_cast<Eigen::Index>(k)); it; ++it) w += it.value() * p(it.row());
+      rows[k] = std::abs(w) <= 0.5 * problem.tolerance;
+    }
+  const std::vector<RowIndex> members_f = members(rows);
+  if (members_f.size() < 2 || members_f.size() > settings_.polish_limit) return;
+  SolverStats ignored;
+  const SparseMatrix sub = principal_submatrix(a, members_f);
+  const Vector q = solve_dense_matrix(Eigen::MatrixXd(sub), gather(c, members_f), ignored);
+  const double roundoff = kImpulseRoundoff * q.lpNorm<Eigen::Infinity>();
+  for (std::size_t i = 0; i < members_f.size(); ++i)
+    if (!problem.equality[members_f[i]] && q(static_cast<Eigen::Index>(i)) < -roundoff) return;
+  if (!q.allFinite()) return;
+  Vector candidate = p;
+  for (std::size_t i = 0; i < members_f.size(); ++i)
+    candidate(members_f[i]) = problem.equality[members_f[i]] ? q(static_cast<Eigen::Index>(i))
+                                                            : std::max(0.0, q(static_cast<Eigen::Index>(i)));
+  // Same velocities to rounding, or keep the basic solution.
+  const Vector change = a * (candidate - p);
+  if (change.lpNorm<Eigen::Infinity>() > 0.5 * problem.tolerance) return;
+  p = std::move(candidate);
+  ++stats.polished;
+}
+
+}  // namespace impetus::ledas

@@ -1,0 +1,213 @@
+// The paper mode's rounds (sec. 3.2): eq. 6, A_SS p = c_S, as equalities on a subset of an island's
+// rows, each independent block by the cheapest exact method (island_solver.hpp), the minimum-norm
+// least-squares solution where a block is rank-deficient (the paper's Figure 2 and its SVD remark).
+#include "ledas/island_solver.hpp"
+#include "ledas/solver_internal.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+namespace impetus::ledas {
+
+Vector IslandSolver::solve_subset(const SparseMatrix& a, const Vector& c, std::span<const RowIndex> subset,
+                                  SolverStats& stats) {
+  Vector p = Vector::Zero(a.rows());
+  solve_subset(a, c, subset, p, stats);
+  return p;
+}
+
+// The subset's rows fall into connected components (rows coupled through A, i.e. through a shared
+// movable body); A_SS is block diagonal in them, so each block is solved on its own by the cheapest
+// exact method. In the paper's rounds most blocks are one or two rows.
+void IslandSolver::solve_subset(const SparseMatrix& a, const Vector& c, std::span<const RowIndex> subset, Vector& p,
+                                SolverStats& stats) {
+  Workspace& w = work_;
+  const auto n = static_cast<int>(subset.size());
+  if (n == 0) return;
+  if (w.slot.size() < static_cast<std::size_t>(a.rows())) w.slot.assign(static_cast<std::size_t>(a.rows()), -1);
+  w.parent.resize(subset.size());
+  for (int i = 0; i < n; ++i) {
+    w.slot[subset[static_cast<std::size_t>(i)]] = i;
+    w.parent[static_cast<std::size_t>(i)] = i;
+  }
+  // Rows coupled to no other row of the subset: closed form at once (p = c / A_11, the single-contact
+  // impulse of the paper's ref. [4]); they leave the component search.
+  bool coupled = false;
+  for (int i = 0; i < n; ++i) {
+    const RowIndex k = subset[static_cast<std::size_t>(i)];
+    double a11 = 0.0;
+    bool alone = true;
+    for (SparseMatrix::InnerIterator it(a, k); it; ++it) {
+      if (it.row() == static_cast<Eigen::Index>(k)) a11 = it.value();
+      else if (w.slot[static_cast<std::size_t>(it.row())] >= 0) alone = false;
+    }
+    if (!alone) {
+      coupled = true;
+      continue;
+    }
+    ++stats.closed_form;
+    if (a11 > 0.0 && std::isfinite(a11)) {
+      p(k) = c(k) / a11;
+    } else {
+      ++stats.singular;
+      p(k) = 0.0;
+    }
+    w.parent[static_cast<std::size_t>(i)] = -1;
+  }
+  if (!coupled) {
+    for (RowIndex k : subset) w.slot[k] = -1;
+    return;
+  }
+  const auto find = [&](int x) {
+    while (w.parent[static_cast<std::size_t>(x)] != x)
+      x = w.parent[static_cast<std::size_t>(x)] = w.parent[static_cast<std::size_t>(w.parent[static_cast<std::size_t>(x)])];
+    return x;
+  };
+  for (int i = 0; i < n; ++i)
+    if (w.parent[static_cast<std::size_t>(i)] >= 0)
+    for (SparseMatrix::InnerIterator it(a, subset[static_cast<std::size_t>(i)]); it; ++it)
+      if (const int j = w.slot[static_cast<std::size_t>(it.row())]; j >= 0) {
+        const int ri = find(i), rj = find(j);
+        if (ri != rj) w.parent[static_cast<std::size_t>(std::max(ri, rj))] = std::min(ri, rj);
+      }
+  // Members of each component in increasing order, components by their first row (deterministic).
+  w.start.assign(subset.size() + 1, 0);
+  for (int i = 0; i < n; ++i)
+    if (w.parent[static_cast<std::size_t>(i)] >= 0) ++w.start[static_cast<std::size_t>(find(i)) + 1];
+  for (std::size_t i = 0; i < subset.size(); ++i) w.start[i + 1] += w.start[i];
+  w.members.resize(subset.size());
+  w.fill.assign(w.start.begin(), w.start.end() - 1);
+  for (int i = 0; i < n; ++i)
+    if (w.parent[static_cast<std::size_t>(i)] >= 0) w.members[static_cast<std::size_t>(w.fill[static_cast<std::size_t>(w.parent[static_cast<std::size_t>(i)])]++)] = i;
+
+  for (int root = 0; root < n; ++root) {
+    if (w.parent[static_cast<std::size_t>(root)] != root) continue;
+    const int begin = w.start[static_cast<std::size_t>(root)], size = w.start[static_cast<std::size_t>(root) + 1] - begin;
+    const auto row = [&](int local) { return subset[static_cast<std::size_t>(w.members[static_cast<std::size_t>(begin + local)])]; };
+    for (int i = 0; i < size; ++i) w.slot[row(i)] = i;  // now: position within the component
+    if (static_cast<std::size_t>(size) <= settings_.dense_limit) {
+      w.dense.setZero(size, size);
+      w.rhs.resize(size);
+      for (int j = 0; j < size; ++j) {
+        w.rhs(j) = c(row(j));
+        for (SparseMatrix::InnerIterator it(a, row(j)); it; ++it)
+          if (const int i = w.slot[static_cast<std::size_t>(it.row())]; i >= 0) w.dense(i, j) = it.value();
+      }
+      const Vector part = solve_dense_matrix(w.dense, w.rhs, stats);
+      for (int i = 0; i < size; ++i) p(row(i)) = part(i);
+    } else {
+      std::vector<RowIndex> rows(static_cast<std::size_t>(size));
+      for (int i = 0; i < size; ++i) rows[static_cast<std::size_t>(i)] = row(i);
+      const Vector part = solve_system(principal_submatrix(a, rows), gather(c, rows), stats);
+      for (int i = 0; i < size; ++i) p(row(i)) = part(i);
+    }
+  }
+  for (RowIndex k : subset) w.slot[k] = -1;
+}
+
+// Chooses the cheapest exact method for one system (see the header).
+Vector IslandSolver::solve_system(const SparseMatrix& m, const Vector& rhs, SolverStats& stats) {
+  const Eigen::Index n = m.rows();
+  if (n == 0) return Vector();
+  const double scale = Vector(m.diagonal()).maxCoeff();
+  if (!(scale > 0.0) || !std::isfinite(scale)) {  // no movable body behind any row: nothing can change
+    ++stats.singular;
+    return Vector::Zero(n);
+  }
+  const double pivot_floor = settings_.rank_tolerance * scale;
+  if (n == 1) {  // closed form: p = c / A_11 (the single-contact impulse of the paper's ref. [4])
+    ++stats.closed_form;
+    const double a11 = m.coeff(0, 0);
+    if (a11 > pivot_floor) return Vector::Constant(1, rhs(0) / a11);
+    ++stats.singular;
+    return Vector::Zero(1);
+  }
+  if (static_cast<std::size_t>(n) <= settings_.dense_limit) return solve_dense_matrix(Eigen::MatrixXd(m), rhs, stats);
+  return solve_sparse(m, rhs, pivot_floor, stats);
+}
+
+Vector IslandSolver::solve_dense_matrix(const Eigen::MatrixXd& a, const Vector& rhs, SolverStats& stats) {
+  ++stats.dense;
+  const double scale = a.diagonal().maxCoeff();
+  if (!(scale > 0.0) || !std::isfinite(scale)) {  // no movable body behind any row
+    ++stats.singular;
+    return Vector::Zero(a.rows());
+  }
+  const double pivot_floor = settings_.rank_tolerance * scale;
+  // LDLᵀ with diagonal pivoting reveals the rank of a PSD matrix: a dependent row leaves a ~0 pivot.
+  const Eigen::LDLT<Eigen::MatrixXd> ldlt(a);
+  if (ldlt.info() == Eigen::Success && (ldlt.vectorD().array() > pivot_floor).all()) return ldlt.solve(rhs);
+  ++stats.singular;
+  // Minimum-norm least squares through the eigen-decomposition (the SVD of a symmetric PSD matrix).
+  const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eigen(a);
+  const Vector& lambda = eigen.eigenvalues();
+  Vector y = eigen.eigenvectors().transpose() * rhs;
+  for (Eigen::Index i = 0; i < y.size(); ++i) y(i) = lambda(i) > pivot_floor ? y(i) / lambda(i) : 0.0;
+  return eigen.eigenvectors() * y;
+}
+
+namespace {
+// Orthonormal basis of the columns of x (thin Q of a Householder QR).
+Eigen::MatrixXd orthonormal_columns(const Eigen::MatrixXd& x) {
+  const Eigen::HouseholderQR<Eigen::MatrixXd> qr(x);
+  return qr.householderQ() * Eigen::MatrixXd::Identity(x.rows(), x.cols());
+}
+}  // namespace
+
+Vector IslandSolver::solve_sparse(const SparseMatrix& m, const Vector& rhs, double pivot_floor,
+                                  SolverStats& stats) {
+  ++stats.sparse;
+  FactorPtr f = checkout(m, stats);
+  f->ldlt.setShift(0.0);
+  f->ldlt.factorize(m);
+  const Vector d = f->ldlt.info() == Eigen::Success ? Vector(f->ldlt.vectorD()) : Vector::Zero(1);
+  const auto small_pivots = static_cast<Eigen::Index>((d.array() <= pivot_floor).count());
+  if (small_pivots == 0) {
+    Vector p = f->ldlt.solve(rhs);
+    checkin(f);
+    return p;
+  }
+  ++stats.singular;
+  // Minimum norm: A + εI (ε = the pivot floor) is positive definite and shares A's eigenvectors.
+  // Shifted inverse iteration converges to the null space of A (eigenvalues ≤ the floor); projecting
+  // it out of the right-hand side and of every correction leaves p in the range of A, i.e. A⁺ c.
+  f->ldlt.setShift(pivot_floor);
+  f->ldlt.factorize(m);
+  const Eigen::Index n = m.rows();
+  Eigen::Index k = std::min(n, small_pivots + 2);  // a little oversampling: the pivot count is a guess
+  Eigen::MatrixXd null_basis;
+  for (;;) {
+    Eigen::MatrixXd x(n, k);
+    for (Eigen::Index j = 0; j < k; ++j)  // deterministic start: a fixed, well-spread pattern
+      for (Eigen::Index i = 0; i < n; ++i) x(i, j) = std::sin(1.0 + 0.7 * static_cast<double>(i) + 1.3 * static_cast<double>(j * j + i * j));
+    for (int pass = 0; pass < 4; ++pass) {
+      const Eigen::MatrixXd y = f->ldlt.solve(x);
+      x = orthonormal_columns(y);
+    }
+    const Eigen::MatrixXd ax = m * x;
+    const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> ritz(x.transpose() * ax);
+    const auto nullity = static_cast<Eigen::Index>((ritz.eigenvalues().array() <= pivot_floor).count());
+    if (nullity < k || k == n) {  // the subspace held more than the null space: it is all found
+      null_basis = x * ritz.eigenvectors().leftCols(nullity);
+      break;
+    }
+    k = std::min(n, 2 * k);
+  }
+  const auto project = [&](Vector v) {
+    if (null_basis.cols() > 0) v -= null_basis * (null_basis.transpose() * v);
+    return v;
+  };
+  const Vector c = project(rhs);
+  Vector p = project(f->ldlt.solve(c));
+  for (int refine = 0; refine < 30; ++refine) {  // iterated Tikhonov on the range: error × ε/(λ+ε)
+    const Vector r = c - m * p;
+    if (r.norm() <= 1e-15 * c.norm()) break;
+    const Vector dp = project(f->ldlt.solve(r));
+    p += dp;
+    if (dp.norm() <= 1e-16 * p.norm()) break;
+  }
+  checkin(f);
+  return p;
+}
+
+}  // namespace impetus::ledas
