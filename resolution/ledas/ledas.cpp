@@ -27,27 +27,16 @@ constexpr double kJointTolerance = 1e-9;
 
 // A of eq. 7 over an island's rows (local indices), both triangles stored. A_ik ≠ 0 only where rows i
 // and k share a movable body, so column k is the union of the row lists of k's (at most two) movable
-// bodies, written in compressed form directly (no triplets, no sort of pairs).
+// bodies, written in compressed form directly (no triplets, no sort of pairs). `movable` lists the
+// island's movable bodies (increasing); `slot_of_body[b]` is b's index in it (−1 for a fixed body).
 SparseMatrix assemble_matrix(std::span<const ImpulseRow> rows, std::span<const std::uint32_t> island,
-                             std::span<const RigidBody> bodies) {
+                             std::span<const BodyIndex> movable, std::span<const std::int32_t> slot_of_body) {
   const std::size_t m = island.size();
-  // Movable bodies of the island, and each one's rows (increasing).
-  std::vector<BodyIndex> movable;
-  movable.reserve(2 * m);
-  for (std::uint32_t g : island)
-    for (BodyIndex body : {rows[g].a, rows[g].b})
-      if (!bodies[body].fixed) movable.push_back(body);
-  std::sort(movable.begin(), movable.end());
-  movable.erase(std::unique(movable.begin(), movable.end()), movable.end());
-  const auto slot_of = [&](BodyIndex body) -> int {
-    if (bodies[body].fixed) return -1;
-    return static_cast<int>(std::lower_bound(movable.begin(), movable.end(), body) - movable.begin());
-  };
   std::vector<std::array<int, 2>> slots(m);
   std::vector<int> start(movable.size() + 1, 0);
   for (std::size_t i = 0; i < m; ++i) {
     const ImpulseRow& r = rows[island[i]];
-    slots[i] = {slot_of(r.a), r.b == r.a ? -1 : slot_of(r.b)};
+    slots[i] = {slot_of_body[r.a], r.b == r.a ? -1 : slot_of_body[r.b]};
     for (int s : slots[i])
       if (s >= 0) ++start[static_cast<std::size_t>(s) + 1];
   }
@@ -96,7 +85,8 @@ double kinetic_energy(std::span<const RigidBody> bodies, std::span<const BodyInd
   double e = 0.0;
   for (BodyIndex i : which) {
     const RigidBody& b = bodies[i];
-    e += 0.5 * b.mass * b.velocity.squaredNorm() + 0.5 * b.angular_velocity.dot(b.inertia_world() * b.angular_velocity);
+    const Vec3 spin_body = b.rotation.transpose() * b.angular_velocity;  // ½ ωᵀ R J Rᵀ ω without forming R J Rᵀ
+    e += 0.5 * b.mass * b.velocity.squaredNorm() + 0.5 * spin_body.dot(b.inertia_body * spin_body);
   }
   return e;
 }
@@ -124,14 +114,22 @@ struct LedasResolver::Island {
   double dt = 0.0;
   double joint_gap = std::numeric_limits<double>::infinity();  // last predicted position-joint gap (m)
 
-  Vector velocities(std::span<const ImpulseRow> all_rows, std::span<const ledas::RowInfo> info,
-                    std::span<const RigidBody> body_state) const {
-    Vector v(static_cast<Eigen::Index>(rows.size()));
-    for (std::size_t i = 0; i < rows.size(); ++i)
-      v(static_cast<Eigen::Index>(i)) = ledas::row_velocity(all_rows[rows[i]], info[rows[i]], body_state);
-    return v;
-  }
+  // Every row's v_n at the bodies' velocities, valid while `velocity_current` (cleared by whatever
+  // changes the island's body velocities without recomputing it).
+  Vector velocity;
+  bool velocity_current = false;
 };
+
+// The rows' velocities v_n (eq. 5) at the bodies' current velocities, recomputed only when stale.
+const Vector& LedasResolver::current_velocities(Island& island, std::span<const RigidBody> bodies) const {
+  if (!island.velocity_current) {
+    island.velocity.resize(static_cast<Eigen::Index>(island.rows.size()));
+    for (std::size_t i = 0; i < island.rows.size(); ++i)
+      island.velocity(static_cast<Eigen::Index>(i)) = ledas::row_velocity(rows_[island.rows[i]], info_[island.rows[i]], bodies);
+    island.velocity_current = true;
+  }
+  return island.velocity;
+}
 
 LedasSettings LedasSettings::from_options(const ModuleOptions& options) {
   LedasSettings s;
@@ -217,6 +215,7 @@ void LedasResolver::resolve_all(std::span<RigidBody> bodies, std::span<Contact> 
   for (const Constraint& c : constraints) ledas::append_constraint_rows(bodies, c, ctx.dt, rows_, info_);
 
   std::vector<std::vector<std::uint32_t>> islands = resolution::find_islands(rows_, bodies.size(), bodies);
+  body_slot_.assign(bodies.size(), -1);
   if (!settings_.islands && islands.size() > 1) {  // one system for everything (benchmarks/model.cpp)
     std::vector<std::uint32_t> all;
     for (const auto& island : islands) all.insert(all.end(), island.begin(), island.end());
@@ -234,7 +233,7 @@ void LedasResolver::resolve_all(std::span<RigidBody> bodies, std::span<Contact> 
     if (bouncing && energy_after > energy_before * (1.0 + kRoundoff) + 1e-300) ++counters.energy_gain_events;
 
     // Residual: the largest approach left below each contact's target, after the velocity phase.
-    const Vector v = island.velocities(rows_, info_, bodies);
+    const Vector& v = current_velocities(island, bodies);
     for (std::size_t i = 0; i < island.rows.size(); ++i) {
       const auto ei = static_cast<Eigen::Index>(i);
       if (island.equality[i]) continue;
@@ -249,18 +248,28 @@ void LedasResolver::resolve_all(std::span<RigidBody> bodies, std::span<Contact> 
     ++stats_.islands;
     stats_.largest_island = std::max(stats_.largest_island, island.rows.size());
     stats_.rounds = std::max(stats_.rounds, island.rounds);
+    for (BodyIndex body : island.bodies) body_slot_[body] = -1;
   }
 }
 
 // An island's system: A (eq. 7), each row's target and restitution.
 LedasResolver::Island LedasResolver::make_island(std::vector<std::uint32_t> rows, std::span<const RigidBody> bodies,
-                                                 double dt) const {
+                                                 double dt) {
   Island island;
   island.rows = std::move(rows);
   island.dt = dt;
   const std::size_t m = island.rows.size();
   const auto em = static_cast<Eigen::Index>(m);
-  island.a = assemble_matrix(rows_, island.rows, bodies);
+  // The island's movable bodies, increasing, each marked with its slot (reset after the island in resolve_all).
+  for (std::uint32_t g : island.rows)
+    for (BodyIndex body : {rows_[g].a, rows_[g].b})
+      if (!bodies[body].fixed && body_slot_[body] < 0) {
+        body_slot_[body] = 0;
+        island.bodies.push_back(body);
+      }
+  std::sort(island.bodies.begin(), island.bodies.end());
+  for (std::size_t s = 0; s < island.bodies.size(); ++s) body_slot_[island.bodies[s]] = static_cast<std::int32_t>(s);
+  island.a = assemble_matrix(rows_, island.rows, island.bodies, body_slot_);
   island.equality.resize(m);
   island.target.resize(em);
   island.restitution = Vector::Zero(em);
@@ -268,20 +277,15 @@ LedasResolver::Island LedasResolver::make_island(std::vector<std::uint32_t> rows
   island.impulse_total = Vector::Zero(em);
   island.entered.assign(m, 0);
   for (std::size_t i = 0; i < m; ++i) {
-    const ImpulseRow& r = rows_[island.rows[i]];
     const ledas::RowInfo& ri = info_[island.rows[i]];
     island.equality[i] = ri.equality;
     // Speculative gap: the contact may approach until the gap closes at the end of the step.
     island.target(static_cast<Eigen::Index>(i)) = ri.equality ? ri.target : std::min(0.0, ri.depth) / dt;
-    for (BodyIndex body : {r.a, r.b})
-      if (!bodies[body].fixed) island.bodies.push_back(body);
   }
-  std::sort(island.bodies.begin(), island.bodies.end());
-  island.bodies.erase(std::unique(island.bodies.begin(), island.bodies.end()), island.bodies.end());
 
   // Restitution per island: the bounce threshold is judged on the island's fastest approach, because
   // touching contacts carry the restitution phase too (resolution/common/resting.hpp).
-  const Vector v = island.velocities(rows_, info_, bodies);
+  const Vector& v = current_velocities(island, bodies);
   double impact_speed = 0.0;
   for (std::size_t i = 0; i < m; ++i) {
     const auto ei = static_cast<Eigen::Index>(i);
@@ -332,6 +336,7 @@ bool LedasResolver::retarget_joints(Island& island, const Vector& v, std::span<c
 void LedasResolver::velocity_paper(Island& island, std::span<RigidBody> bodies, ResolverCounters& counters) {
   const std::size_t m = island.rows.size();
   const std::size_t nb = island.bodies.size();
+  island.velocity_current = false;  // the rounds keep their own velocities
   // Per row: its movable bodies' slots in island.bodies (−1 for a fixed body) and the fixed bodies'
   // share of v_n. Per body: its rows (local indices).
   std::vector<std::array<std::int32_t, 2>> slots(m);
@@ -348,8 +353,8 @@ void LedasResolver::velocity_paper(Island& island, std::span<RigidBody> bodies, 
         const double u = bodies[body].velocity_at(is_b ? ri.point_b : r.point).dot(r.normal);
         fixed_share[i] += is_b ? u : -u;
       } else {
-        const auto s = std::lower_bound(island.bodies.begin(), island.bodies.end(), body) - island.bodies.begin();
-        slots[i][static_cast<std::size_t>(k)] = static_cast<std::int32_t>(s);
+        const std::int32_t s = body_slot_[body];
+        slots[i][static_cast<std::size_t>(k)] = s;
         if (!(is_b && r.a == r.b)) ++body_start[static_cast<std::size_t>(s) + 1];
       }
       ++k;
@@ -480,7 +485,7 @@ void LedasResolver::velocity_complementary(Island& island, std::span<RigidBody> 
   problem.start.resize(m);
   problem.tolerance = settings_.tolerance;
   for (std::uint64_t round = 0;; ++round) {
-    const Vector v = island.velocities(rows_, info_, bodies);
+    const Vector& v = current_velocities(island, bodies);  // (finish_round changes it: not used after)
     bool needed = retarget_joints(island, v, bodies) && round > 0;
     Vector target = island.target;
     for (std::size_t i = 0; i < m; ++i) {
@@ -518,7 +523,8 @@ void LedasResolver::finish_round(Island& island, const Vector& p, const Vector& 
   const std::size_t m = island.rows.size();
   for (std::size_t i = 0; i < m; ++i) resolution::apply_row_impulse(rows_[island.rows[i]], p(static_cast<Eigen::Index>(i)), bodies);
   island.impulse_inelastic += p;
-  const Vector v = island.velocities(rows_, info_, bodies);
+  island.velocity_current = false;
+  const Vector& v = current_velocities(island, bodies);
   island.complementarity = 0.0;
   for (std::size_t i = 0; i < m; ++i) {
     const auto ei = static_cast<Eigen::Index>(i);
@@ -527,8 +533,10 @@ void LedasResolver::finish_round(Island& island, const Vector& p, const Vector& 
   }
   for (std::size_t i = 0; i < m; ++i) {
     const auto ei = static_cast<Eigen::Index>(i);
-    if (island.restitution(ei) != 0.0)
+    if (island.restitution(ei) != 0.0) {
       resolution::apply_row_impulse(rows_[island.rows[i]], island.restitution(ei) * p(ei), bodies);
+      island.velocity_current = false;
+    }
     island.impulse_total(ei) += (1.0 + island.restitution(ei)) * p(ei);
   }
 }

@@ -109,7 +109,8 @@ class LedasResolver final : public CollisionResolver {
   struct Island;
   void resolve_all(std::span<RigidBody> bodies, std::span<Contact> contacts, std::span<const Constraint> constraints,
                    const StepContext& ctx, ResolverCounters& counters);
-  Island make_island(std::vector<std::uint32_t> rows, std::span<const RigidBody> bodies, double dt) const;
+  Island make_island(std::vector<std::uint32_t> rows, std::span<const RigidBody> bodies, double dt);
+  const ledas::Vector& current_velocities(Island& island, std::span<const RigidBody> bodies) const;
   void velocity_paper(Island& island, std::span<RigidBody> bodies, ResolverCounters& counters);
   void velocity_complementary(Island& island, std::span<RigidBody> bodies, ResolverCounters& counters);
   bool retarget_joints(Island& island, const ledas::Vector& v, std::span<const RigidBody> bodies) const;
@@ -121,6 +122,7 @@ class LedasResolver final : public CollisionResolver {
   LedasStats stats_;
   std::vector<resolution::ImpulseRow> rows_;  // this step's rows: contacts first, then joint rows
   std::vector<ledas::RowInfo> info_;
+  std::vector<std::int32_t> body_slot_;  // per body: its slot in the current island's movable bodies, or −1
 };
 
 }  // namespace impetus

@@ -66,12 +66,34 @@ void MaskedLdlt::analyze(const Matrix& a) {
   for (int k = 0; k < n; ++k)
     l_outer_[static_cast<std::size_t>(k) + 1] = l_outer_[static_cast<std::size_t>(k)] + l_count_[static_cast<std::size_t>(k)];
   l_index_.resize(static_cast<std::size_t>(l_outer_.back()));
+
+  // The pattern of every row of L (columns i < k, in a topological order of the elimination tree:
+  // descendants first), found once here by the etree walk ldl_numeric does per row, so factorize() only
+  // reads it.
+  pattern_.assign(static_cast<std::size_t>(n), 0);
+  row_outer_.assign(static_cast<std::size_t>(n) + 1, 0);
+  row_index_.resize(l_index_.size());
+  flag_.assign(static_cast<std::size_t>(n), -1);
+  for (int k = 0, q = 0; k < n; ++k) {
+    flag_[static_cast<std::size_t>(k)] = k;
+    int top = n;
+    for (int p = c_outer_[static_cast<std::size_t>(k)]; p < c_outer_[static_cast<std::size_t>(k) + 1]; ++p) {
+      int len = 0;
+      for (int i = c_row_[static_cast<std::size_t>(p)]; flag_[static_cast<std::size_t>(i)] != k; i = parent_[static_cast<std::size_t>(i)]) {
+        pattern_[static_cast<std::size_t>(len++)] = i;
+        flag_[static_cast<std::size_t>(i)] = k;
+      }
+      while (len > 0) pattern_[static_cast<std::size_t>(--top)] = pattern_[static_cast<std::size_t>(--len)];
+    }
+    for (; top < n; ++top) row_index_[static_cast<std::size_t>(q++)] = pattern_[static_cast<std::size_t>(top)];
+    row_outer_[static_cast<std::size_t>(k) + 1] = q;
+  }
   l_value_.resize(l_index_.size());
   d_.assign(static_cast<std::size_t>(n), 1.0);
+  d_inverse_.assign(static_cast<std::size_t>(n), 0.0);
   diag_.assign(static_cast<std::size_t>(n), 0.0);
   state_.assign(static_cast<std::size_t>(n), kOff);
   y_.assign(static_cast<std::size_t>(n), 0.0);
-  pattern_.assign(static_cast<std::size_t>(n), 0);
 }
 
 bool MaskedLdlt::same_pattern(const Matrix& a) const {
@@ -81,71 +103,76 @@ bool MaskedLdlt::same_pattern(const Matrix& a) const {
          std::equal(inner_.begin(), inner_.end(), a.innerIndexPtr());
 }
 
-// ldl_numeric, row by row (row k of L from a sparse triangular solve along the elimination tree),
-// with rows off F skipped and rows with a vanishing pivot dropped.
+// ldl_numeric, row by row (row k of L from a sparse triangular solve along the elimination tree, on
+// the row pattern analyze() recorded), with rows off F skipped and rows with a vanishing pivot dropped.
+// Entries that come out exactly zero (a row of the full pattern that F does not reach) are not stored.
 std::size_t MaskedLdlt::factorize(const Matrix& a, std::span<const char> on, double rank_tolerance, double floor,
                                   double shift) {
   const auto n = static_cast<int>(order_.size());
   const double* value = a.valuePtr();
+  const int* c_outer = c_outer_.data();
+  const int* c_row = c_row_.data();
+  const int* c_value = c_value_.data();
+  const int* row_outer = row_outer_.data();
+  const int* row_index = row_index_.data();
+  const int* l_outer = l_outer_.data();
+  int* l_count = l_count_.data();
+  int* l_index = l_index_.data();
+  double* l_value = l_value_.data();
+  double* y = y_.data();
+  double* d_inverse = d_inverse_.data();
+  char* state = state_.data();
+  int* stored = pattern_.data();  // the columns row k put an entry in
   std::size_t dropped = 0;
   for (int k = 0; k < n; ++k) {
     const auto uk = static_cast<std::size_t>(k);
-    l_count_[uk] = 0;
-    flag_[uk] = k;
+    l_count[uk] = 0;
     if (!on[static_cast<std::size_t>(order_[uk])]) {
-      state_[uk] = kOff;
+      state[uk] = kOff;
       d_[uk] = 1.0;
+      d_inverse[uk] = 0.0;
       continue;
     }
-    // Scatter column k of C (rows i ≤ k that are in F) and find the pattern of row k of L.
-    int top = n;
+    // Scatter column k of C (rows i ≤ k that are in F).
     double diagonal = 0.0;
-    for (int p = c_outer_[uk]; p < c_outer_[uk + 1]; ++p) {
-      int i = c_row_[static_cast<std::size_t>(p)];
-      const double v = value[c_value_[static_cast<std::size_t>(p)]];
-      if (i == k) {
-        diagonal += v;
-        continue;
-      }
-      if (state_[static_cast<std::size_t>(i)] != kOn) continue;
-      y_[static_cast<std::size_t>(i)] += v;
-      int len = 0;
-      for (; flag_[static_cast<std::size_t>(i)] != k; i = parent_[static_cast<std::size_t>(i)]) {
-        pattern_[static_cast<std::size_t>(len++)] = i;
-        flag_[static_cast<std::size_t>(i)] = k;
-      }
-      while (len > 0) pattern_[static_cast<std::size_t>(--top)] = pattern_[static_cast<std::size_t>(--len)];
+    for (int p = c_outer[uk]; p < c_outer[uk + 1]; ++p) {
+      const auto i = static_cast<std::size_t>(c_row[p]);
+      const double v = value[c_value[p]];
+      if (i == uk) diagonal += v;
+      else if (state[i] == kOn) y[i] += v;
     }
     double dk = diagonal + shift;
-    const int first = top;
-    for (; top < n; ++top) {
-      const auto i = static_cast<std::size_t>(pattern_[static_cast<std::size_t>(top)]);
-      const double yi = y_[i];
-      y_[i] = 0.0;
-      if (state_[i] != kOn) continue;  // off or dropped: no entries in its column, nothing to eliminate
-      const int end = l_outer_[i] + l_count_[i];
-      for (int p = l_outer_[i]; p < end; ++p) y_[static_cast<std::size_t>(l_index_[static_cast<std::size_t>(p)])] -= l_value_[static_cast<std::size_t>(p)] * yi;
-      const double lki = yi / d_[i];
+    int entries = 0;
+    for (int t = row_outer[uk]; t < row_outer[uk + 1]; ++t) {
+      const auto i = static_cast<std::size_t>(row_index[t]);
+      const double yi = y[i];
+      y[i] = 0.0;
+      // Off or dropped (no entries in its column), or not reached from F's entries: nothing to eliminate.
+      if (yi == 0.0 || state[i] != kOn) continue;
+      const int begin = l_outer[i];
+      const int end = begin + l_count[i];
+      for (int p = begin; p < end; ++p) y[l_index[p]] -= l_value[p] * yi;
+      const double lki = yi * d_inverse[i];
       dk -= lki * yi;
-      l_index_[static_cast<std::size_t>(end)] = k;
-      l_value_[static_cast<std::size_t>(end)] = lki;
-      ++l_count_[i];
+      l_index[end] = k;
+      l_value[end] = lki;
+      ++l_count[i];
+      stored[entries++] = static_cast<int>(i);
     }
     diag_[uk] = diagonal;
     if (diagonal <= floor || dk <= rank_tolerance * (diagonal + shift)) {
       // Dependent on the rows before it: take back its entries (the last of each column) and make it an
       // identity row that later rows do not see.
-      for (int t = first; t < n; ++t) {
-        const auto i = static_cast<std::size_t>(pattern_[static_cast<std::size_t>(t)]);
-        if (state_[i] == kOn) --l_count_[i];
-      }
-      state_[uk] = kDropped;
+      for (int t = 0; t < entries; ++t) --l_count[stored[t]];
+      state[uk] = kDropped;
       d_[uk] = 1.0;
+      d_inverse[uk] = 0.0;
       ++dropped;
       continue;
     }
-    state_[uk] = kOn;
+    state[uk] = kOn;
     d_[uk] = dk;
+    d_inverse[uk] = 1.0 / dk;
   }
   return dropped;
 }
@@ -161,20 +188,23 @@ std::size_t MaskedLdlt::redundant_rows(double shift) const {
 
 void MaskedLdlt::solve(Eigen::Ref<Eigen::VectorXd> x) const {
   const auto n = order_.size();
-  std::vector<double>& y = y_;  // zero between calls
+  double* y = y_.data();  // zero between calls
+  const int* l_outer = l_outer_.data();
+  const int* l_count = l_count_.data();
+  const int* l_index = l_index_.data();
+  const double* l_value = l_value_.data();
+  const double* d_inverse = d_inverse_.data();  // 0 on rows off F and dropped rows
   for (std::size_t k = 0; k < n; ++k) y[k] = state_[k] == kOn ? x(order_[k]) : 0.0;
   for (std::size_t j = 0; j < n; ++j) {  // L y = b
     const double yj = y[j];
     if (yj == 0.0) continue;
-    const int end = l_outer_[j] + l_count_[j];
-    for (int p = l_outer_[j]; p < end; ++p) y[static_cast<std::size_t>(l_index_[static_cast<std::size_t>(p)])] -= l_value_[static_cast<std::size_t>(p)] * yj;
+    const int end = l_outer[j] + l_count[j];
+    for (int p = l_outer[j]; p < end; ++p) y[l_index[p]] -= l_value[p] * yj;
   }
-  for (std::size_t j = 0; j < n; ++j) y[j] = state_[j] == kOn ? y[j] / d_[j] : 0.0;
-  for (std::size_t j = n; j-- > 0;) {  // Lᵀ x = y
-    if (state_[j] != kOn) continue;
-    double yj = y[j];
-    const int end = l_outer_[j] + l_count_[j];
-    for (int p = l_outer_[j]; p < end; ++p) yj -= l_value_[static_cast<std::size_t>(p)] * y[static_cast<std::size_t>(l_index_[static_cast<std::size_t>(p)])];
+  for (std::size_t j = n; j-- > 0;) {  // D⁻¹, then Lᵀ x = y
+    double yj = y[j] * d_inverse[j];
+    const int end = l_outer[j] + l_count[j];
+    for (int p = l_outer[j]; p < end; ++p) yj -= l_value[p] * y[l_index[p]];
     y[j] = yj;
   }
   for (std::size_t k = 0; k < n; ++k) {

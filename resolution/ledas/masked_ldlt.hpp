@@ -63,7 +63,8 @@ class MaskedLdlt {
   std::vector<int> c_outer_, c_row_, c_value_;
   std::vector<int> parent_, l_outer_;    // elimination tree; column starts of L
   std::vector<int> l_count_, l_index_;
-  std::vector<double> l_value_, d_, diag_;
+  std::vector<int> row_outer_, row_index_;  // pattern of each row of L for the full pattern (topological)
+  std::vector<double> l_value_, d_, d_inverse_, diag_;  // d_inverse_: 1/d on rows of F kept, else 0
   std::vector<char> state_;
   // Workspace.
   mutable std::vector<double> y_;
