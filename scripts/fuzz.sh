@@ -57,10 +57,13 @@ run_one() {
   local inputs=("$work" "$root/fuzz/corpus/$target")
   [ -d "$root/fuzz/regressions/$target" ] && inputs+=("$root/fuzz/regressions/$target")  # git keeps no empty ones
   "$build/bin/fuzz_$target" "${args[@]}" "${inputs[@]}" >"$log" 2>&1 || status=$?
-  local runs crashes
+  local runs crashes slow
   runs=$(sed -n 's/^stat::number_of_executed_units: *//p' "$log" | tail -1)
-  crashes=$(find "$artifacts" -type f | wc -l)
-  printf 'fuzz: %-10s %10s executions in %s s, %s crash inputs, exit %s\n' "$target" "${runs:-?}" "$seconds" "$crashes" "$status"
+  # libFuzzer also writes slow-unit-* files (inputs that took long but passed): reported, not failures.
+  slow=$(find "$artifacts" -type f -name 'slow-unit-*' | wc -l)
+  crashes=$(find "$artifacts" -type f ! -name 'slow-unit-*' | wc -l)
+  printf 'fuzz: %-10s %10s executions in %s s, %s crash inputs, %s slow inputs, exit %s\n' \
+    "$target" "${runs:-?}" "$seconds" "$crashes" "$slow" "$status"
   if [ "$status" -ne 0 ]; then
     echo "fuzz: $target failed; the end of $log:"
     tail -40 "$log"

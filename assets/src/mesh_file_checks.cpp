@@ -109,6 +109,7 @@ void check_ply(const std::filesystem::path& file, std::uintmax_t size) {
     std::uintmax_t count_size = 0;  // > 0: a list, whose length takes this many bytes
   };
   struct Element {
+    std::string name;
     std::uintmax_t count = 0;
     std::vector<Property> properties;
   };
@@ -142,6 +143,7 @@ void check_ply(const std::filesystem::path& file, std::uintmax_t size) {
       std::string name;
       Element element;
       if (!(words >> name >> element.count)) bad("an element line needs a name and a count: '" + line + "'");
+      element.name = name;
       if (element.count > size) bad("element '" + name + "' announces more items than the file has bytes");
       elements.push_back(element);
     } else if (keyword == "property") {
@@ -164,6 +166,15 @@ void check_ply(const std::filesystem::path& file, std::uintmax_t size) {
     }
   }
   if (!ended) bad("no 'end_header' line in its first " + std::to_string(kMaxHeader) + " bytes");
+  // Faces with no vertex element to index made assimp 5.2 loop until its CPU limit (fuzz/mesh_ply).
+  const auto count_of = [&](const std::string& name) {
+    std::uintmax_t count = 0;
+    for (const Element& element : elements)
+      if (element.name == name) count += element.count;
+    return count;
+  };
+  if (count_of("face") > 0 && count_of("vertex") == 0)
+    bad(std::to_string(count_of("face")) + " faces but no vertices (no 'element vertex' with a count above 0)");
   if (binary) {
     // Walk the body as assimp will, list lengths included (garbage lengths made it abort; fuzz/mesh_ply).
     std::uintmax_t at = static_cast<std::uintmax_t>(in.tellg());

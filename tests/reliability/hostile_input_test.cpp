@@ -271,11 +271,17 @@ std::vector<Row> rows() {
                      return load_mesh(dir.path() / "a.obj");
                    },
                    "a.obj: "});
-  // Found by the fuzzers (fuzz/regressions): assimp's PLY reader ran past its buffer on these, and a
+  // Found by the fuzzers (fuzz/regressions): assimp's PLY reader ran past its buffer or looped on these, and a
   // self-intersecting mesh passed validation with an impossible inertia.
   table.push_back({"mesh_ply_without_end_header",
                    [] { return load_mesh(source_dir() / "fuzz/regressions/mesh_ply/segv-assimp-no-end-header.ply"); },
                    "malformed PLY header"});
+  table.push_back({"mesh_ply_faces_without_vertices",
+                   [] {
+                     return load_mesh(source_dir() /
+                                      "fuzz/regressions/mesh_ply/slow-assimp-faces-without-vertices.ply");
+                   },
+                   "malformed PLY header: 20 faces but no vertices"});
   table.push_back({"mesh_ply_truncated",
                    [] {
                      Scratch dir("truncated-ply");
