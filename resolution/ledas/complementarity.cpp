@@ -21,13 +21,17 @@ constexpr int kMaxRefinementSteps = 100;
 }  // namespace
 
 // The active set changed from the rows B of the last factorization to W = (B \ R) ∪ D by a few rows.
-// With F the factorization of A_BB, p_R = 0 is imposed by multipliers μ on the rows R and the new rows
-// D border the system:
-//   A_BB p_B + A_BD p_D + E_R μ = c_B,   A_DB p_B + A_DD p_D = c_D,   E_Rᵀ p_B = 0.
-// With U = [A_BD, E_R], p_B = F⁻¹(c_B − U y) for y = (p_D, μ), and y solves the small Schur system
-//   ([A_DD 0; 0 0] − Uᵀ F⁻¹ U) y = (c_D, 0) − Uᵀ F⁻¹ c_B.
-// Returns false (refactor) when the Schur system is (nearly) singular or the result does not hold the
-// active rows to 1e-10 relative.
+// With F = P ᵀL D Lᵀ P the factorization of (A + εI)_BB, p_R = 0 is imposed by multipliers μ on the rows
+// R and the new rows D border the system:
+//   (A + εI)_BB p_B + A_BD p_D + E_R μ = c_B,   A_DB p_B + (A + εI)_DD p_D = c_D,   E_Rᵀ p_B = 0.
+// With U = [A_BD, E_R], p_B = F⁻¹(c_B − U y), and y = (p_D, μ) solves the small Schur system
+//   S y = (c_D, 0) − Uᵀ F⁻¹ c_B,   S = [(A + εI)_DD 0; 0 0] − Uᵀ F⁻¹ U.
+// With W = L⁻¹ P U, Uᵀ F⁻¹ U = Wᵀ D⁻¹ W: each column of W is a sparse forward solve along the
+// elimination tree (MaskedLdlt::forward_sparse), kept with its Gram entries while the factorization
+// is (the changes of an active-set search mostly grow), and one right-hand side costs one solve split
+// in halves: t = L⁻¹ P c, y from Wᵀ D⁻¹ t, then p_B = Pᵀ L⁻ᵀ D⁻¹ (t − W y).
+// Returns false (refactor) when S is (nearly) singular or the result does not hold the active rows to
+// 1e-10 relative.
 bool IslandSolver::solve_updated(ActiveLoop& loop, const SparseMatrix& a, double shift, const Vector& c,
                                  const std::vector<char>& active, Vector& p, SolverStats& stats) {
   if (loop.updated && loop.updated_for == active) {  // the same free set as the last update: reuse it
@@ -44,23 +48,23 @@ bool IslandSolver::solve_updated(ActiveLoop& loop, const SparseMatrix& a, double
     if (active[k] && !loop.in_base[k]) added.push_back(static_cast<RowIndex>(k));
     if (!active[k] && loop.in_base[k]) removed.push_back(static_cast<RowIndex>(k));
   }
-  const auto n = a.rows();
   const auto nd = static_cast<Eigen::Index>(added.size());
   const auto size = nd + static_cast<Eigen::Index>(removed.size());
   if (size == 0) return false;
-  Eigen::MatrixXd& y = loop.columns;
-  y.setZero(n, size);
-  for (Eigen::Index j = 0; j < nd; ++j)
+  loop.slots.clear();
+  for (RowIndex d : added) loop.slots.push_back(border(loop, a, d));
+  for (RowIndex r : removed) loop.slots.push_back(border(loop, a, r));
+  Eigen::MatrixXd schur(size, size);
+  for (Eigen::Index j = 0; j < size; ++j)
+    for (Eigen::Index i = 0; i < size; ++i) schur(i, j) = -loop.gram(loop.slots[static_cast<std::size_t>(i)], loop.slots[static_cast<std::size_t>(j)]);
+  for (Eigen::Index j = 0; j < nd; ++j) {
+    schur(j, j) += shift;
     for (SparseMatrix::InnerIterator it(a, added[static_cast<std::size_t>(j)]); it; ++it)
-      if (loop.in_base[static_cast<std::size_t>(it.row())]) y(it.row(), j) = it.value();
-  for (std::size_t j = 0; j < removed.size(); ++j) y(removed[j], nd + static_cast<Eigen::Index>(j)) = 1.0;
-  Eigen::MatrixXd& u = loop.borders;
-  u = y;
-  for (Eigen::Index j = 0; j < size; ++j) loop.factor->solve(y.col(j));
-  Eigen::MatrixXd schur = -u.transpose() * y;
-  for (Eigen::Index i = 0; i < nd; ++i)
-    for (Eigen::Index j = 0; j < nd; ++j)
-      schur(i, j) += a.coeff(added[static_cast<std::size_t>(i)], added[static_cast<std::size_t>(j)]) + (i == j ? shift : 0.0);
+      if (active[static_cast<std::size_t>(it.row())] && !loop.in_base[static_cast<std::size_t>(it.row())]) {
+        const auto i = std::lower_bound(added.begin(), added.end(), static_cast<RowIndex>(it.row())) - added.begin();
+        schur(i, j) += it.value();
+      }
+  }
   loop.schur.compute(schur);
   loop.schur.setThreshold(settings_.rank_tolerance);
   if (loop.schur.rank() < size) return false;  // numerically singular: refactor
@@ -82,17 +86,73 @@ bool IslandSolver::solve_updated(ActiveLoop& loop, const SparseMatrix& a, double
   return true;
 }
 
+// The entry of `borders` for a row that joins (u = A_B,row) or leaves (u = e_row) the factorization's
+// rows B: computed on first use, with its Gram entries against the borders already there.
+int IslandSolver::border(ActiveLoop& loop, const SparseMatrix& a, RowIndex row) {
+  if (loop.border_of.size() != static_cast<std::size_t>(a.rows())) loop.border_of.assign(static_cast<std::size_t>(a.rows()), -1);
+  if (const int known = loop.border_of[row]; known >= 0) return known;
+  std::vector<std::pair<int, double>> u;
+  if (loop.in_base[row]) {
+    u.emplace_back(static_cast<int>(row), 1.0);
+  } else {
+    for (SparseMatrix::InnerIterator it(a, row); it; ++it)
+      if (loop.in_base[static_cast<std::size_t>(it.row())]) u.emplace_back(static_cast<int>(it.row()), it.value());
+  }
+  ActiveLoop::Border w;
+  loop.factor->forward_sparse(u, w.index, w.value);
+  // G_jk = w_jᵀ D⁻¹ w_k against every earlier border, by scattering D⁻¹ w into a dense vector.
+  const auto count = static_cast<Eigen::Index>(loop.borders.size());
+  Vector& scattered = loop.coupling;
+  scattered.setZero(static_cast<Eigen::Index>(loop.factor->rows()));
+  double self = 0.0;
+  for (std::size_t q = 0; q < w.index.size(); ++q) {
+    const double scaled = w.value[q] * loop.factor->pivot_inverse(w.index[q]);
+    scattered(w.index[q]) = scaled;
+    self += scaled * w.value[q];
+  }
+  loop.gram.conservativeResize(count + 1, count + 1);
+  for (Eigen::Index j = 0; j < count; ++j) {
+    const ActiveLoop::Border& other = loop.borders[static_cast<std::size_t>(j)];
+    double dot = 0.0;
+    for (std::size_t q = 0; q < other.index.size(); ++q) dot += other.value[q] * scattered(other.index[q]);
+    loop.gram(j, count) = loop.gram(count, j) = dot;
+  }
+  loop.gram(count, count) = self;
+  loop.borders.push_back(std::move(w));
+  loop.border_of[row] = static_cast<int>(count);
+  return static_cast<int>(count);
+}
+
+void IslandSolver::ActiveLoop::refactored() {
+  for (std::size_t k = 0; k < border_of.size(); ++k) border_of[k] = -1;
+  borders.clear();
+  gram.resize(0, 0);
+  updated = false;
+}
+
 // The solution of the bordered system above for the right-hand side c, from the stored update.
-void IslandSolver::apply_update(const ActiveLoop& loop, const Vector& c, Vector& out) {
+void IslandSolver::apply_update(ActiveLoop& loop, const Vector& c, Vector& out) {
   const auto nd = static_cast<Eigen::Index>(loop.added.size());
-  out = c;
-  loop.factor->solve(out);  // z0 = F⁻¹ c_B
-  Vector rhs = -loop.borders.transpose() * out;
-  for (Eigen::Index i = 0; i < nd; ++i) rhs(i) += c(loop.added[static_cast<std::size_t>(i)]);
-  const Vector sol = loop.schur.solve(rhs);
-  out.noalias() -= loop.columns * sol;
+  const auto size = static_cast<Eigen::Index>(loop.slots.size());
+  const MaskedLdlt& f = *loop.factor;
+  Vector& t = loop.forward;
+  f.forward(c, t);  // t = L⁻¹ P c_B
+  Vector rhs(size);  // (c_D, 0) − Wᵀ D⁻¹ t
+  for (Eigen::Index j = 0; j < size; ++j) {
+    const ActiveLoop::Border& w = loop.borders[static_cast<std::size_t>(loop.slots[static_cast<std::size_t>(j)])];
+    double dot = 0.0;
+    for (std::size_t q = 0; q < w.index.size(); ++q) dot += w.value[q] * f.pivot_inverse(w.index[q]) * t(w.index[q]);
+    rhs(j) = (j < nd ? c(loop.added[static_cast<std::size_t>(j)]) : 0.0) - dot;
+  }
+  const Vector y = loop.schur.solve(rhs);
+  for (Eigen::Index j = 0; j < size; ++j) {  // t − W y
+    const ActiveLoop::Border& w = loop.borders[static_cast<std::size_t>(loop.slots[static_cast<std::size_t>(j)])];
+    for (std::size_t q = 0; q < w.index.size(); ++q) t(w.index[q]) -= w.value[q] * y(j);
+  }
+  out.resize(c.size());
+  f.backward(t, out);  // p_B = Pᵀ L⁻ᵀ D⁻¹ (t − W y); zero off B
   for (RowIndex r : loop.removed) out(r) = 0.0;
-  for (Eigen::Index j = 0; j < nd; ++j) out(loop.added[static_cast<std::size_t>(j)]) = sol(j);
+  for (Eigen::Index j = 0; j < nd; ++j) out(loop.added[static_cast<std::size_t>(j)]) = y(j);
 }
 
 // Solves (A + εI)_FF z = r_F for the free rows F: by the current factorization when F is the one it
@@ -109,12 +169,15 @@ Vector IslandSolver::solve_active(const SparseMatrix& a, double shift, const Vec
       return z;
     }
     Vector z;
-    if (changes <= settings_.update_limit && solve_updated(loop, a, shift, r, active, z, stats)) return z;
+    const std::size_t limit = settings_.update_limit > 0
+                                  ? settings_.update_limit
+                                  : std::max<std::size_t>(8, static_cast<std::size_t>(std::sqrt(static_cast<double>(active.size()))));
+    if (changes <= limit && solve_updated(loop, a, shift, r, active, z, stats)) return z;
   }
   ++stats.sparse;
   loop.factor->factorize(a, active, settings_.rank_tolerance, loop.floor, shift);
   loop.factored = true;
-  loop.updated = false;
+  loop.refactored();
   loop.singular = loop.singular || loop.factor->redundant_rows(shift) > 0;
   for (std::size_t k = 0; k < active.size(); ++k) loop.in_base[k] = active[k] && !loop.factor->dropped(k);
   Vector z = r;
@@ -345,7 +408,7 @@ IslandSolver::Refinement IslandSolver::refine_on_free_set(const SparseMatrix& a,
     ++stats.sparse;
     loop.factor->factorize(a, free_rows, settings_.rank_tolerance, loop.floor, shift);
     loop.factored = true;
-    loop.updated = false;
+    loop.refactored();
     for (std::size_t k = 0; k < m; ++k) loop.in_base[k] = free_rows[k] && !loop.factor->dropped(k);
   }
   Vector& residual = work_.residual;

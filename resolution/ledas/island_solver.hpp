@@ -53,7 +53,10 @@ struct SolverSettings {
   /// (an eigen-decomposition when it is singular, which costs more than the solve itself above ~16 rows).
   std::size_t polish_limit = 16;
   double rank_tolerance = 1e-10;  ///< a pivot or eigenvalue ≤ this × max A_ii counts as zero
-  std::size_t update_limit = 8;  ///< sparse path: largest active-set change solved by an update
+  /// Sparse path: largest active-set change solved by an update of the last factorization; 0: automatic,
+  /// max(8, √rows) (an update costs about its rows² × the elimination tree's height, ~√rows on a
+  /// contact network, against ~rows^1.5 for a factorization).
+  std::size_t update_limit = 0;
   std::uint64_t max_iterations = 10000;  ///< active-set iterations per complementarity problem
   /// Complementarity problems: proximal regularization ε = this × max A_kk (solve_complementarity): the
   /// first solve's and the final one.
@@ -137,13 +140,26 @@ class IslandSolver {
     double floor = 0.0;               // A_kk at or below this: nothing movable behind row k
     bool singular = false;            // a factorization met a redundant row (pivot ≈ the shift)
     std::vector<char> in_base;        // rows of the last factorization (free and not dropped)
-    // The last Schur-complement update (solve_updated): the free set it solves for, its border
-    // columns U, Y = F⁻¹U and the factorized Schur system; reused while the free set stays.
+    // Border columns of the updates against the last factorization (solve_updated): per row that
+    // joined or left F, w = L⁻¹ P u (sparse), and the Gram matrix G_ij = w_iᵀ D⁻¹ w_j of those
+    // computed so far. Kept while the factorization is, so a growing change costs only its new rows.
+    struct Border {
+      std::vector<int> index;  // elimination order, increasing
+      std::vector<double> value;
+    };
+    std::vector<Border> borders;
+    std::vector<int> border_of;       // per row: its entry in borders, or −1
+    Eigen::MatrixXd gram;
+    // The last update: the free set it solves for, its added and removed rows (their entries in
+    // borders, added first) and the factorized Schur system; reused while the free set stays.
     bool updated = false;
     std::vector<char> updated_for;
     std::vector<RowIndex> added, removed;
-    Eigen::MatrixXd columns, borders;
+    std::vector<int> slots;
     Eigen::FullPivLU<Eigen::MatrixXd> schur;
+    Vector forward, coupling;         // apply_update's workspace
+
+    void refactored();                // forgets the borders and the update of the old factorization
   };
   struct Workspace {  // reused buffers (no allocation per round once warm)
     std::vector<int> slot, parent, start, fill, members;  // subset components
@@ -164,7 +180,8 @@ class IslandSolver {
   Vector solve_sparse(const SparseMatrix& m, const Vector& rhs, double pivot_floor, SolverStats& stats);
   bool solve_updated(ActiveLoop& loop, const SparseMatrix& a, double shift, const Vector& c,
                      const std::vector<char>& active, Vector& p, SolverStats& stats);
-  static void apply_update(const ActiveLoop& loop, const Vector& c, Vector& out);
+  static void apply_update(ActiveLoop& loop, const Vector& c, Vector& out);
+  static int border(ActiveLoop& loop, const SparseMatrix& a, RowIndex row);
   void polish_minimum_norm(const SparseMatrix& a, const Vector& c, std::vector<char> rows,
                            const ComplementarityProblem& problem, Vector& p, SolverStats& stats);
   FactorPtr checkout(const SparseMatrix& m, SolverStats& stats);

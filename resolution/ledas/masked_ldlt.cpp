@@ -94,6 +94,9 @@ void MaskedLdlt::analyze(const Matrix& a) {
   diag_.assign(static_cast<std::size_t>(n), 0.0);
   state_.assign(static_cast<std::size_t>(n), kOff);
   y_.assign(static_cast<std::size_t>(n), 0.0);
+  visited_.assign(static_cast<std::size_t>(n), 0);
+  reach_.clear();
+  stamp_ = 0;
 }
 
 bool MaskedLdlt::same_pattern(const Matrix& a) const {
@@ -124,6 +127,7 @@ std::size_t MaskedLdlt::factorize(const Matrix& a, std::span<const char> on, dou
   char* state = state_.data();
   int* stored = pattern_.data();  // the columns row k put an entry in
   std::size_t dropped = 0;
+  double work = 0.0;
   for (int k = 0; k < n; ++k) {
     const auto uk = static_cast<std::size_t>(k);
     l_count[uk] = 0;
@@ -151,6 +155,7 @@ std::size_t MaskedLdlt::factorize(const Matrix& a, std::span<const char> on, dou
       if (yi == 0.0 || state[i] != kOn) continue;
       const int begin = l_outer[i];
       const int end = begin + l_count[i];
+      work += end - begin + 1;
       for (int p = begin; p < end; ++p) y[l_index[p]] -= l_value[p] * yi;
       const double lki = yi * d_inverse[i];
       dk -= lki * yi;
@@ -174,6 +179,7 @@ std::size_t MaskedLdlt::factorize(const Matrix& a, std::span<const char> on, dou
     d_[uk] = dk;
     d_inverse[uk] = 1.0 / dk;
   }
+  work_ = work;
   return dropped;
 }
 
@@ -187,29 +193,81 @@ std::size_t MaskedLdlt::redundant_rows(double shift) const {
 }
 
 void MaskedLdlt::solve(Eigen::Ref<Eigen::VectorXd> x) const {
+  forward(x, scratch_);
+  backward(scratch_, x);
+}
+
+}  // namespace impetus::ledas
+
+namespace impetus::ledas {
+
+void MaskedLdlt::forward(const Eigen::Ref<const Eigen::VectorXd>& b, Eigen::VectorXd& t) const {
   const auto n = order_.size();
-  double* y = y_.data();  // zero between calls
+  t.resize(static_cast<Eigen::Index>(n));
   const int* l_outer = l_outer_.data();
   const int* l_count = l_count_.data();
   const int* l_index = l_index_.data();
   const double* l_value = l_value_.data();
-  const double* d_inverse = d_inverse_.data();  // 0 on rows off F and dropped rows
-  for (std::size_t k = 0; k < n; ++k) y[k] = state_[k] == kOn ? x(order_[k]) : 0.0;
-  for (std::size_t j = 0; j < n; ++j) {  // L y = b
+  double* y = t.data();
+  for (std::size_t k = 0; k < n; ++k) y[k] = state_[k] == kOn ? b(order_[k]) : 0.0;
+  for (std::size_t j = 0; j < n; ++j) {  // L t = P b
     const double yj = y[j];
     if (yj == 0.0) continue;
     const int end = l_outer[j] + l_count[j];
     for (int p = l_outer[j]; p < end; ++p) y[l_index[p]] -= l_value[p] * yj;
   }
+}
+
+void MaskedLdlt::backward(Eigen::VectorXd& t, Eigen::Ref<Eigen::VectorXd> x) const {
+  const auto n = order_.size();
+  const int* l_outer = l_outer_.data();
+  const int* l_count = l_count_.data();
+  const int* l_index = l_index_.data();
+  const double* l_value = l_value_.data();
+  const double* d_inverse = d_inverse_.data();
+  double* y = t.data();
   for (std::size_t j = n; j-- > 0;) {  // D⁻¹, then Lᵀ x = y
     double yj = y[j] * d_inverse[j];
     const int end = l_outer[j] + l_count[j];
     for (int p = l_outer[j]; p < end; ++p) yj -= l_value[p] * y[l_index[p]];
     y[j] = yj;
   }
-  for (std::size_t k = 0; k < n; ++k) {
-    x(order_[k]) = y[k];
-    y[k] = 0.0;
+  for (std::size_t k = 0; k < n; ++k) x(order_[k]) = y[k];
+}
+
+void MaskedLdlt::forward_sparse(std::span<const std::pair<int, double>> u, std::vector<int>& index,
+                                std::vector<double>& value) const {
+  index.clear();
+  value.clear();
+  if (++stamp_ == 0) {  // the stamp wrapped: forget every visit
+    std::fill(visited_.begin(), visited_.end(), 0);
+    stamp_ = 1;
+  }
+  reach_.clear();
+  double* y = y_.data();  // zero between calls
+  for (const auto& [row, v] : u) {
+    const int i = new_of_old_[static_cast<std::size_t>(row)];
+    if (state_[static_cast<std::size_t>(i)] != kOn) continue;
+    y[i] += v;
+    for (int j = i; j != -1 && visited_[static_cast<std::size_t>(j)] != stamp_; j = parent_[static_cast<std::size_t>(j)]) {
+      visited_[static_cast<std::size_t>(j)] = stamp_;
+      reach_.push_back(j);
+    }
+  }
+  std::sort(reach_.begin(), reach_.end());  // a child precedes its parent in the elimination order
+  for (const int j : reach_) {
+    const double yj = y[j];
+    if (yj == 0.0) continue;
+    const int end = l_outer_[static_cast<std::size_t>(j)] + l_count_[static_cast<std::size_t>(j)];
+    for (int p = l_outer_[static_cast<std::size_t>(j)]; p < end; ++p)
+      y[l_index_[static_cast<std::size_t>(p)]] -= l_value_[static_cast<std::size_t>(p)] * yj;
+  }
+  for (const int j : reach_) {
+    if (y[j] != 0.0) {
+      index.push_back(j);
+      value.push_back(y[j]);
+    }
+    y[j] = 0.0;
   }
 }
 

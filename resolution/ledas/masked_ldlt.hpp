@@ -21,6 +21,7 @@
 
 #include <cstdint>
 #include <span>
+#include <utility>
 #include <vector>
 
 namespace impetus::ledas {
@@ -44,6 +45,22 @@ class MaskedLdlt {
   /// Solves A_FF x_F = b_F in place (original row order, size n): on exit x is 0 outside F and on the
   /// dropped rows.
   void solve(Eigen::Ref<Eigen::VectorXd> x) const;
+
+  /// solve() in two halves, so that an update (a bordered system, complementarity.cpp) can correct the
+  /// intermediate vector: forward() gives t = L⁻¹ P b on the rows of the factorization (elimination
+  /// order, size rows(), zero elsewhere); backward() gives x = Pᵀ L⁻ᵀ D⁻¹ t, overwriting t.
+  void forward(const Eigen::Ref<const Eigen::VectorXd>& b, Eigen::VectorXd& t) const;
+  void backward(Eigen::VectorXd& t, Eigen::Ref<Eigen::VectorXd> x) const;
+  /// The forward half for a right-hand side u with few non-zeros (pairs (original row, value); rows
+  /// outside the factorization are ignored): w = L⁻¹ P u as its non-zeros (elimination order,
+  /// increasing). It visits only the elimination-tree ancestors of u's rows (every entry L_ij lies on
+  /// the path from j to the root), about the tree's height in columns instead of all of them.
+  void forward_sparse(std::span<const std::pair<int, double>> u, std::vector<int>& index,
+                      std::vector<double>& value) const;
+  /// 1/d_i of row i in elimination order: 0 off the factorization and on dropped rows.
+  double pivot_inverse(int i) const { return d_inverse_[static_cast<std::size_t>(i)]; }
+  /// Flops (multiply-adds) of the last factorize(): the cost an update is weighed against.
+  double factorization_work() const { return work_; }
 
   /// Rows of the last (shifted) factorization whose pivot is at most √(shift·A_kk): the rows (nearly)
   /// dependent on the rows eliminated before them (A_FF is singular if there is one).
@@ -69,6 +86,10 @@ class MaskedLdlt {
   // Workspace.
   mutable std::vector<double> y_;
   std::vector<int> flag_, pattern_;
+  mutable Eigen::VectorXd scratch_;           // solve()'s intermediate vector
+  mutable std::vector<int> reach_, visited_;  // forward_sparse: the ancestors, a visit stamp per row
+  mutable int stamp_ = 0;
+  double work_ = 0.0;
 };
 
 }  // namespace impetus::ledas
