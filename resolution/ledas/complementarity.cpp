@@ -225,7 +225,8 @@ Vector IslandSolver::solve_complementarity(const ComplementarityProblem& problem
   for (std::size_t k = 0; k < m; ++k) free_rows[k] = problem.equality[k] || problem.start[k];
   Vector p = Vector::Zero(a.rows());
   if (m == 0) return p;
-  const double scale = Vector(a.diagonal()).maxCoeff();
+  work_.diagonal = a.diagonal();
+  const double scale = work_.diagonal.maxCoeff();
   if (!(scale > 0.0) || !std::isfinite(scale)) {  // nothing movable behind any row
     ++stats.singular;
     return p;
@@ -427,7 +428,7 @@ IslandSolver::Refinement IslandSolver::refine_on_free_set(const SparseMatrix& a,
   std::vector<char>& solved_rows = work_.solved_rows;
   solved_rows.resize(m);
   for (std::size_t k = 0; k < m; ++k)
-    solved_rows[k] = free_rows[k] && a.coeff(static_cast<Eigen::Index>(k), static_cast<Eigen::Index>(k)) > loop.floor;
+    solved_rows[k] = free_rows[k] && work_.diagonal(static_cast<Eigen::Index>(k)) > loop.floor;
   const auto restrict_to_base = [&](Vector& v) {
     for (std::size_t k = 0; k < m; ++k)
       if (!solved_rows[k]) v(static_cast<Eigen::Index>(k)) = 0.0;
@@ -439,7 +440,7 @@ IslandSolver::Refinement IslandSolver::refine_on_free_set(const SparseMatrix& a,
   precondition(residual, preconditioned);
   direction = preconditioned;
   double rz = residual.dot(preconditioned);
-  const double scale = Vector(a.diagonal()).maxCoeff();
+  const double scale = work_.diagonal.maxCoeff();
   bool solved = false;
   for (int step = 0; step <= kMaxRefinementSteps; ++step) {
     const double rounding = 1e-14 * (scale * x.lpNorm<Eigen::Infinity>() + c.lpNorm<Eigen::Infinity>());

@@ -165,6 +165,7 @@ class IslandSolver {
     std::vector<int> slot, parent, start, fill, members;  // subset components
     Eigen::MatrixXd dense;
     Vector rhs;
+    Vector diagonal;  // A_kk of the complementarity problem being solved
     Vector residual, preconditioned, direction, product;  // refine_on_free_set
     std::vector<char> solved_rows;
   };
