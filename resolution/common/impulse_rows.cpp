@@ -6,8 +6,17 @@
 
 namespace impetus::resolution {
 
-ImpulseRow make_row(std::span<const RigidBody> bodies, BodyIndex ia, BodyIndex ib, const Vec3& point,
-                    const Vec3& normal, double restitution) {
+void InverseInertiaCache::reset(std::size_t body_count) {
+  ++generation_;
+  matrix_.resize(body_count);
+  generation_of_.resize(body_count, 0);
+}
+
+namespace {
+// make_row with J⁻¹ of a body from `inv_inertia(body index)`.
+template <class InverseInertia>
+ImpulseRow row_from(std::span<const RigidBody> bodies, InverseInertia&& inv_inertia, BodyIndex ia, BodyIndex ib,
+                    const Vec3& point, const Vec3& normal, double restitution) {
   const RigidBody& a = bodies[ia];
   const RigidBody& b = bodies[ib];
   ImpulseRow row;
@@ -19,14 +28,27 @@ ImpulseRow make_row(std::span<const RigidBody> bodies, BodyIndex ia, BodyIndex i
   if (!a.fixed) {
     row.inv_mass_a = a.inv_mass;
     row.arm_a = (point - a.position).cross(normal);
-    row.turn_a = a.inv_inertia_world() * row.arm_a;
+    row.turn_a = inv_inertia(ia) * row.arm_a;
   }
   if (!b.fixed) {
     row.inv_mass_b = b.inv_mass;
     row.arm_b = (point - b.position).cross(normal);
-    row.turn_b = b.inv_inertia_world() * row.arm_b;
+    row.turn_b = inv_inertia(ib) * row.arm_b;
   }
   return row;
+}
+}  // namespace
+
+ImpulseRow make_row(std::span<const RigidBody> bodies, BodyIndex ia, BodyIndex ib, const Vec3& point,
+                    const Vec3& normal, double restitution) {
+  return row_from(
+      bodies, [&](BodyIndex i) { return bodies[i].inv_inertia_world(); }, ia, ib, point, normal, restitution);
+}
+
+ImpulseRow make_row(std::span<const RigidBody> bodies, InverseInertiaCache& inertia, BodyIndex ia, BodyIndex ib,
+                    const Vec3& point, const Vec3& normal, double restitution) {
+  return row_from(
+      bodies, [&](BodyIndex i) -> const Mat3& { return inertia.get(bodies, i); }, ia, ib, point, normal, restitution);
 }
 
 ImpulseRow make_contact_row(std::span<const RigidBody> bodies, const Contact& contact) {
@@ -34,32 +56,9 @@ ImpulseRow make_contact_row(std::span<const RigidBody> bodies, const Contact& co
                   combined_restitution(bodies[contact.a], bodies[contact.b]));
 }
 
-namespace {
-// The term of eq. 7 for one shared body s: σ_i σ_k [n_i·n_k / M_s + (r_{s,i}×n_i)·J_s⁻¹(r_{s,k}×n_k)].
-double body_term(double sigma, double inv_mass, const Vec3& normal_i, const Vec3& arm_i,
-                 const Vec3& normal_k, const Vec3& turn_k) {
-  return sigma * (inv_mass * normal_i.dot(normal_k) + arm_i.dot(turn_k));
-}
-}  // namespace
-
-double coupling(const ImpulseRow& i, const ImpulseRow& k) {
-  double a_ik = 0.0;
-  // Body a of row i: σ_{s,i} = −1. It is shared with row k as k's a (σ = −1) or k's b (σ = +1).
-  if (i.inv_mass_a != 0.0) {  // a movable body (fixed bodies have no terms)
-    if (i.a == k.a) a_ik += body_term(+1.0, i.inv_mass_a, i.normal, i.arm_a, k.normal, k.turn_a);
-    if (i.a == k.b) a_ik += body_term(-1.0, i.inv_mass_a, i.normal, i.arm_a, k.normal, k.turn_b);
-  }
-  if (i.inv_mass_b != 0.0) {
-    if (i.b == k.a) a_ik += body_term(-1.0, i.inv_mass_b, i.normal, i.arm_b, k.normal, k.turn_a);
-    if (i.b == k.b) a_ik += body_term(+1.0, i.inv_mass_b, i.normal, i.arm_b, k.normal, k.turn_b);
-  }
-  return a_ik;
-}
-
-double row_velocity(const ImpulseRow& row, std::span<const RigidBody> bodies) {
-  const RigidBody& a = bodies[row.a];
-  const RigidBody& b = bodies[row.b];
-  return (b.velocity_at(row.point) - a.velocity_at(row.point)).dot(row.normal);
+ImpulseRow make_contact_row(std::span<const RigidBody> bodies, InverseInertiaCache& inertia, const Contact& contact) {
+  return make_row(bodies, inertia, contact.a, contact.b, contact.point, contact.normal,
+                  combined_restitution(bodies[contact.a], bodies[contact.b]));
 }
 
 void apply_row_impulse(const ImpulseRow& row, double p, std::span<RigidBody> bodies) {

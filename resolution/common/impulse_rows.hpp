@@ -34,22 +34,81 @@ struct ImpulseRow {
   double restitution = 0.0;
 };
 
+/// The world-frame inverse inertia J⁻¹ = R J_body⁻¹ Rᵀ (RigidBody::inv_inertia_world) of the bodies a
+/// step's rows touch, each computed once instead of once per row (a sphere in a pyramid carries up to
+/// twelve contacts). The same matrices, so rows built through it are bit-identical to rows built
+/// without it.
+class InverseInertiaCache {
+ public:
+  /// Forgets every matrix (O(1): a new generation) and sizes the cache for `body_count` bodies.
+  void reset(std::size_t body_count);
+  /// Body `index`'s J⁻¹ (1/(kg·m²)), computed on its first use since reset(). Valid until the body turns.
+  const Mat3& get(std::span<const RigidBody> bodies, BodyIndex index) {
+    if (generation_of_[index] != generation_) {
+      generation_of_[index] = generation_;
+      // RigidBody::inv_inertia_world's expression (keep them equal), evaluated in place: copying the
+      // returned matrix in cost a failed store forwarding per body, a quarter of a row's set-up.
+      const RigidBody& body = bodies[index];
+      matrix_[index].noalias() = body.rotation * body.inv_inertia_body * body.rotation.transpose();
+    }
+    return matrix_[index];
+  }
+
+ private:
+  std::vector<Mat3> matrix_;
+  std::vector<std::uint64_t> generation_of_;  // per body: the generation its matrix was computed in
+  std::uint64_t generation_ = 0;
+};
+
 /// Builds the row for a direction `normal` at `point` between bodies `ia` and `ib` of `bodies`.
 ImpulseRow make_row(std::span<const RigidBody> bodies, BodyIndex ia, BodyIndex ib, const Vec3& point,
                     const Vec3& normal, double restitution = 0.0);
+/// The same row, taking the bodies' J⁻¹ from `inertia` (reset() for `bodies` at their current poses).
+ImpulseRow make_row(std::span<const RigidBody> bodies, InverseInertiaCache& inertia, BodyIndex ia, BodyIndex ib,
+                    const Vec3& point, const Vec3& normal, double restitution = 0.0);
 
 /// The row of a contact, with the combined restitution of its bodies.
 ImpulseRow make_contact_row(std::span<const RigidBody> bodies, const Contact& contact);
+/// The same row, taking the bodies' J⁻¹ from `inertia`.
+ImpulseRow make_contact_row(std::span<const RigidBody> bodies, InverseInertiaCache& inertia, const Contact& contact);
 
 /// A_ik: how a unit impulse on row k changes the velocity of row i (eq. 7). Zero unless they share a
-/// movable body.
-double coupling(const ImpulseRow& i, const ImpulseRow& k);
+/// movable body. Inline: assembling A calls it once per non-zero.
+inline double coupling(const ImpulseRow& i, const ImpulseRow& k) {
+  // The term of eq. 7 for one shared body s: σ_i σ_k [n_i·n_k / M_s + (r_{s,i}×n_i)·J_s⁻¹(r_{s,k}×n_k)].
+  const auto body_term = [](double sigma, double inv_mass, const Vec3& normal_i, const Vec3& arm_i,
+                            const Vec3& normal_k, const Vec3& turn_k) {
+    return sigma * (inv_mass * normal_i.dot(normal_k) + arm_i.dot(turn_k));
+  };
+  double a_ik = 0.0;
+  // Body a of row i: σ_{s,i} = −1. It is shared with row k as k's a (σ = −1) or k's b (σ = +1).
+  if (i.inv_mass_a != 0.0) {  // a movable body (fixed bodies have no terms)
+    if (i.a == k.a) a_ik += body_term(+1.0, i.inv_mass_a, i.normal, i.arm_a, k.normal, k.turn_a);
+    if (i.a == k.b) a_ik += body_term(-1.0, i.inv_mass_a, i.normal, i.arm_a, k.normal, k.turn_b);
+  }
+  if (i.inv_mass_b != 0.0) {
+    if (i.b == k.a) a_ik += body_term(-1.0, i.inv_mass_b, i.normal, i.arm_b, k.normal, k.turn_a);
+    if (i.b == k.b) a_ik += body_term(+1.0, i.inv_mass_b, i.normal, i.arm_b, k.normal, k.turn_b);
+  }
+  return a_ik;
+}
 
 /// A_kk = 1/m_eff of a single row: n·n/M_a + (r_a×n)·J_a⁻¹(r_a×n) + the same for b.
 inline double self_coupling(const ImpulseRow& row) { return coupling(row, row); }
 
+/// Velocity of the material point of `body` at world `point` (m/s): RigidBody::velocity_at, bit for bit,
+/// with the lever arm r = p − x named first. GCC compiles velocity_at's nested Eigen expression through
+/// the stack (two scalar stores read back as one vector: a failed store forwarding), which tripled the
+/// cost of a row's velocity, the resolvers' most frequent evaluation.
+inline Vec3 point_velocity(const RigidBody& body, const Vec3& point) {
+  const Vec3 arm = point - body.position;
+  return body.velocity + body.angular_velocity.cross(arm);
+}
+
 /// v_n = (u_b − u_a)·n of the row at the bodies' current velocities (m/s; < 0 approaches).
-double row_velocity(const ImpulseRow& row, std::span<const RigidBody> bodies);
+inline double row_velocity(const ImpulseRow& row, std::span<const RigidBody> bodies) {
+  return (point_velocity(bodies[row.b], row.point) - point_velocity(bodies[row.a], row.point)).dot(row.normal);
+}
 
 /// Applies impulse magnitude `p` along the row (eq. 3): −p n on a, +p n on b. Fixed bodies unchanged.
 void apply_row_impulse(const ImpulseRow& row, double p, std::span<RigidBody> bodies);

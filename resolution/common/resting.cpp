@@ -1,7 +1,5 @@
 #include "common/resting.hpp"
 
-#include <algorithm>
-
 namespace impetus::resolution {
 
 RestingSettings RestingSettings::from_options(const ModuleOptions& options) {
@@ -10,14 +8,6 @@ RestingSettings RestingSettings::from_options(const ModuleOptions& options) {
   s.correction = options.number("correction", s.correction, 0.0, 1.0);
   s.bounce_threshold = options.number("bounce_threshold", s.bounce_threshold, 0.0, 1e3);
   return s;
-}
-
-double effective_restitution(const ImpulseRow& row, double impact_speed, const RestingSettings& settings) {
-  return impact_speed < settings.bounce_threshold ? 0.0 : row.restitution;
-}
-
-double correction_target(double depth, const RestingSettings& settings) {
-  return settings.correction * std::max(0.0, depth - settings.slop);
 }
 
 void apply_row_displacement(const ImpulseRow& row, double q, std::span<RigidBody> bodies) {

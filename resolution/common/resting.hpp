@@ -20,6 +20,8 @@
 #include "common/impulse_rows.hpp"
 #include "impetus/modules/options.hpp"
 
+#include <algorithm>
+
 namespace impetus::resolution {
 
 /// Resting-contact settings, read from a resolver's options.
@@ -34,10 +36,14 @@ struct RestingSettings {
 
 /// The restitution applied at a row of an island whose fastest approach speed is `impact_speed`
 /// (m/s, ≥ 0): the row's coefficient, or 0 below the bounce threshold.
-double effective_restitution(const ImpulseRow& row, double impact_speed, const RestingSettings& settings);
+inline double effective_restitution(const ImpulseRow& row, double impact_speed, const RestingSettings& settings) {
+  return impact_speed < settings.bounce_threshold ? 0.0 : row.restitution;
+}
 
 /// Separation (m along n) the position correction asks for at a contact of `depth` (m).
-double correction_target(double depth, const RestingSettings& settings);
+inline double correction_target(double depth, const RestingSettings& settings) {
+  return settings.correction * std::max(0.0, depth - settings.slop);
+}
 
 /// Moves the row's bodies apart by pseudo-impulse `q` (kg·m): Δx = σ q n / M, and R turned by
 /// σ q J⁻¹ (r × n) (Rodrigues). Velocities are unchanged. Fixed bodies do not move.

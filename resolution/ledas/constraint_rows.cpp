@@ -19,13 +19,13 @@ Vec3 predicted_point(const RigidBody& body, const Vec3& p, double dt) {
 }
 
 // One equality row along `normal` (unit) acting at point_a on a and point_b on b.
-void append_row(std::span<const RigidBody> bodies, BodyIndex a, BodyIndex b, const Vec3& point_a,
-                const Vec3& point_b, const Vec3& normal, ConstraintLevel level, double dt,
+void append_row(std::span<const RigidBody> bodies, resolution::InverseInertiaCache& inertia, BodyIndex a, BodyIndex b,
+                const Vec3& point_a, const Vec3& point_b, const Vec3& normal, ConstraintLevel level, double dt,
                 std::vector<ImpulseRow>& rows, std::vector<RowInfo>& info) {
-  ImpulseRow row = resolution::make_row(bodies, a, b, point_a, normal, 0.0);  // e = 0 (sec. 4)
+  ImpulseRow row = resolution::make_row(bodies, inertia, a, b, point_a, normal, 0.0);  // e = 0 (sec. 4)
   if (const RigidBody& body_b = bodies[b]; !body_b.fixed) {  // b's arm from its own point
     row.arm_b = (point_b - body_b.position).cross(normal);
-    row.turn_b = body_b.inv_inertia_world() * row.arm_b;
+    row.turn_b = inertia.get(bodies, b) * row.arm_b;
   }
   RowInfo ri;
   ri.point_b = point_b;
@@ -70,17 +70,14 @@ double predicted_separation(const ImpulseRow& row, const RowInfo& info, std::spa
   return (predicted_point(bodies[row.b], info.point_b, dt) - predicted_point(bodies[row.a], row.point, dt)).dot(row.normal);
 }
 
-double row_velocity(const ImpulseRow& row, const RowInfo& info, std::span<const RigidBody> bodies) {
-  return (bodies[row.b].velocity_at(info.point_b) - bodies[row.a].velocity_at(row.point)).dot(row.normal);
-}
-
-void append_constraint_rows(std::span<const RigidBody> bodies, const Constraint& constraint, double dt,
-                            std::vector<ImpulseRow>& rows, std::vector<RowInfo>& info) {
+void append_constraint_rows(std::span<const RigidBody> bodies, resolution::InverseInertiaCache& inertia,
+                            const Constraint& constraint, double dt, std::vector<ImpulseRow>& rows,
+                            std::vector<RowInfo>& info) {
   if (const auto* pp = std::get_if<PointPointConstraint>(&constraint)) {
     const Vec3 point_a = world_point(bodies[pp->a], pp->anchor_a);
     const Vec3 point_b = world_point(bodies[pp->b], pp->anchor_b);
     for (int axis = 0; axis < 3; ++axis)
-      append_row(bodies, pp->a, pp->b, point_a, point_b, Vec3::Unit(axis), pp->level, dt, rows, info);
+      append_row(bodies, inertia, pp->a, pp->b, point_a, point_b, Vec3::Unit(axis), pp->level, dt, rows, info);
     return;
   }
   const auto& co = std::get<CoaxialConstraint>(constraint);
@@ -89,8 +86,8 @@ void append_constraint_rows(std::span<const RigidBody> bodies, const Constraint&
   const Vec3 normal_2 = f.direction.cross(normal_1);
   for (const Vec3& q : f.points_b) {
     const Vec3 foot = foot_on_axis(q, f.origin, f.direction);
-    append_row(bodies, co.a, co.b, foot, q, normal_1, co.level, dt, rows, info);
-    append_row(bodies, co.a, co.b, foot, q, normal_2, co.level, dt, rows, info);
+    append_row(bodies, inertia, co.a, co.b, foot, q, normal_1, co.level, dt, rows, info);
+    append_row(bodies, inertia, co.a, co.b, foot, q, normal_2, co.level, dt, rows, info);
   }
 }
 

@@ -40,21 +40,27 @@ struct RowInfo {
 };
 
 /// The row's relative normal velocity (u_b(point_b) − u_a(point))·n (m/s, < 0 approaches), u = v + ω×r.
-/// For a contact (point_b = point) it is resolution::row_velocity.
-double row_velocity(const resolution::ImpulseRow& row, const RowInfo& info, std::span<const RigidBody> bodies);
+/// For a contact (point_b = point) it is resolution::row_velocity. Inline: evaluated for every row twice
+/// per round.
+inline double row_velocity(const resolution::ImpulseRow& row, const RowInfo& info, std::span<const RigidBody> bodies) {
+  return (resolution::point_velocity(bodies[row.b], info.point_b) - resolution::point_velocity(bodies[row.a], row.point))
+      .dot(row.normal);
+}
 
 /// A position-level joint row's separation s⁺ (m, along the row) after a step of `dt` at the bodies'
 /// current velocities, the bodies moved as eq. 2 moves them (x += dt v, R = Q(ω dt) R).
 double predicted_separation(const resolution::ImpulseRow& row, const RowInfo& info,
                             std::span<const RigidBody> bodies, double dt);
 
-/// Appends the rows of `constraint` at the bodies' current poses for a step of `dt` (s):
+/// Appends the rows of `constraint` at the bodies' current poses for a step of `dt` (s), the bodies' J⁻¹
+/// from `inertia` (reset for `bodies`):
 ///  - point-point: three rows at the joined points, normals along the world axes (mutually
 ///    perpendicular, as the paper prescribes), e = 0;
 ///  - coaxial: at b's two axis points q_0 = anchor_b and q_1 = anchor_b + length·axis_b, the foot of
 ///    each on a's axis, two rows with normals perpendicular to a's axis (sec. 4, last paragraph).
-void append_constraint_rows(std::span<const RigidBody> bodies, const Constraint& constraint, double dt,
-                            std::vector<resolution::ImpulseRow>& rows, std::vector<RowInfo>& info);
+void append_constraint_rows(std::span<const RigidBody> bodies, resolution::InverseInertiaCache& inertia,
+                            const Constraint& constraint, double dt, std::vector<resolution::ImpulseRow>& rows,
+                            std::vector<RowInfo>& info);
 
 /// How far a constraint is from holding (m): point-point, |p_b − p_a|; coaxial, the larger distance of
 /// b's two axis points from a's axis.

@@ -198,6 +198,7 @@ void LedasResolver::resolve_all(std::span<RigidBody> bodies, std::span<Contact> 
                                 ResolverCounters& counters) {
   rows_.clear();
   info_.clear();
+  inertia_.reset(bodies.size());
   for (std::size_t k = 0; k < contacts.size(); ++k) {
     Contact& c = contacts[k];
     c.impulse = 0.0;
@@ -205,14 +206,14 @@ void LedasResolver::resolve_all(std::span<RigidBody> bodies, std::span<Contact> 
       ++counters.nan_caught;
       continue;
     }
-    rows_.push_back(resolution::make_contact_row(bodies, c));
+    rows_.push_back(resolution::make_contact_row(bodies, inertia_, c));
     ledas::RowInfo ri;
     ri.point_b = c.point;
     ri.depth = c.depth;
     ri.contact = static_cast<std::int64_t>(k);
     info_.push_back(ri);
   }
-  for (const Constraint& c : constraints) ledas::append_constraint_rows(bodies, c, ctx.dt, rows_, info_);
+  for (const Constraint& c : constraints) ledas::append_constraint_rows(bodies, inertia_, c, ctx.dt, rows_, info_);
 
   std::vector<std::vector<std::uint32_t>> islands = resolution::find_islands(rows_, bodies.size(), bodies);
   body_slot_.assign(bodies.size(), -1);
@@ -233,14 +234,20 @@ void LedasResolver::resolve_all(std::span<RigidBody> bodies, std::span<Contact> 
     if (bouncing && energy_after > energy_before * (1.0 + kRoundoff) + 1e-300) ++counters.energy_gain_events;
 
     // Residual: the largest approach left below each contact's target, after the velocity phase.
+    // (Accumulated in locals: the counters may alias the contacts written in the loop, which would
+    // keep them in memory.)
     const Vector& v = current_velocities(island, bodies);
+    double residual = counters.residual;
+    std::uint64_t entered = 0;
     for (std::size_t i = 0; i < island.rows.size(); ++i) {
       const auto ei = static_cast<Eigen::Index>(i);
       if (island.equality[i]) continue;
-      counters.residual = std::max(counters.residual, island.target(ei) - v(ei));
-      if (island.entered[i]) ++counters.contacts;
+      residual = std::max(residual, island.target(ei) - v(ei));
+      if (island.entered[i]) ++entered;
       contacts[static_cast<std::size_t>(info_[island.rows[i]].contact)].impulse = island.impulse_total(ei);
     }
+    counters.residual = residual;
+    counters.contacts += entered;
     counters.complementarity_error = std::max(counters.complementarity_error, island.complementarity);
 
     correct_positions(island, bodies);
@@ -412,12 +419,13 @@ void LedasResolver::velocity_paper(Island& island, std::span<RigidBody> bodies, 
   std::vector<RowIndex> subset;
   subset.reserve(m);
   const auto measure_complementarity = [&] {  // after an inelastic phase, over every contact
-    island.complementarity = 0.0;
+    double complementarity = 0.0;  // a local: island.complementarity would be kept in memory
     for (std::size_t i = 0; i < m; ++i) {
       const auto ei = static_cast<Eigen::Index>(i);
       if (!island.equality[i])
-        island.complementarity = std::max(island.complementarity, std::abs(island.impulse_inelastic(ei) * (v(ei) - target(ei))));
+        complementarity = std::max(complementarity, std::abs(island.impulse_inelastic(ei) * (v(ei) - target(ei))));
     }
+    island.complementarity = complementarity;
   };
   for (std::uint64_t round = 0;; ++round) {
     const bool refine_joints = position_joints && retarget_joints(island, v, bodies) && round > 0;
@@ -525,12 +533,13 @@ void LedasResolver::finish_round(Island& island, const Vector& p, const Vector& 
   island.impulse_inelastic += p;
   island.velocity_current = false;
   const Vector& v = current_velocities(island, bodies);
-  island.complementarity = 0.0;
+  double complementarity = 0.0;  // a local: island.complementarity would be kept in memory
   for (std::size_t i = 0; i < m; ++i) {
     const auto ei = static_cast<Eigen::Index>(i);
     if (!island.equality[i])
-      island.complementarity = std::max(island.complementarity, std::abs(island.impulse_inelastic(ei) * (v(ei) - target(ei))));
+      complementarity = std::max(complementarity, std::abs(island.impulse_inelastic(ei) * (v(ei) - target(ei))));
   }
+  island.complementarity = complementarity;
   for (std::size_t i = 0; i < m; ++i) {
     const auto ei = static_cast<Eigen::Index>(i);
     if (island.restitution(ei) != 0.0) {

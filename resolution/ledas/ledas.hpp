@@ -122,6 +122,7 @@ class LedasResolver final : public CollisionResolver {
   LedasStats stats_;
   std::vector<resolution::ImpulseRow> rows_;  // this step's rows: contacts first, then joint rows
   std::vector<ledas::RowInfo> info_;
+  resolution::InverseInertiaCache inertia_;  // the bodies' J⁻¹ while this step's rows are built
   std::vector<std::int32_t> body_slot_;  // per body: its slot in the current island's movable bodies, or −1
 };
 
