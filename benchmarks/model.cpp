@@ -96,13 +96,14 @@ void model(benchmark::State& state, const std::string& lever, bool on) {
     return;
   }
   const std::vector<RigidBody> initial(world->bodies().begin(), world->bodies().end());
-  const auto [sum, last] = bench::time_steps(state, *world, initial);
+  const auto [sum, last, cold_ms] = bench::time_steps(state, *world, initial);
   const auto per_step = benchmark::Counter::kAvgIterations;
   state.counters["bodies"] = static_cast<double>(initial.size());
   state.counters["contacts"] = static_cast<double>(last.detector.contacts);
   state.counters["rows_solved"] = static_cast<double>(last.resolver.contacts);
   state.counters["islands"] = static_cast<double>(last.resolver.islands);
   state.counters["residual"] = last.resolver.residual;
+  state.counters["cold_ms"] = cold_ms;
   state.counters["detect_ms"] = benchmark::Counter(1e3 * sum.detect, per_step);
   state.counters["resolve_ms"] = benchmark::Counter(1e3 * sum.resolve, per_step);
 }

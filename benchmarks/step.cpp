@@ -34,7 +34,7 @@ void step(benchmark::State& state, const std::string& resolver_name, bool pyrami
   world.set_detector(std::make_shared<FclDetector>());
   world.set_resolver(bench::make_resolver(resolver_name, /*velocity_only=*/false));
 
-  const auto [sum, last] = bench::time_steps(state, world, initial);
+  const auto [sum, last, cold_ms] = bench::time_steps(state, world, initial);
   const auto per_step = benchmark::Counter::kAvgIterations;
   state.counters["bodies"] = static_cast<double>(initial.size() - 1);
   state.counters["contacts"] = static_cast<double>(last.detector.contacts);
@@ -44,6 +44,7 @@ void step(benchmark::State& state, const std::string& resolver_name, bool pyrami
   state.counters["detect_ms"] = benchmark::Counter(1e3 * sum.detect, per_step);
   state.counters["resolve_ms"] = benchmark::Counter(1e3 * sum.resolve, per_step);
   state.counters["positions_ms"] = benchmark::Counter(1e3 * sum.positions, per_step);
+  state.counters["cold_ms"] = cold_ms;
   state.counters["resolve_share"] = sum.total > 0 ? sum.resolve / sum.total : 0.0;
 }
 
