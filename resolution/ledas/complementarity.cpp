@@ -21,7 +21,7 @@ constexpr int kMaxRefinementSteps = 100;
 }  // namespace
 
 // The active set changed from the rows B of the last factorization to W = (B \ R) ∪ D by a few rows.
-// With F = P ᵀL D Lᵀ P the factorization of (A + εI)_BB, p_R = 0 is imposed by multipliers μ on the rows
+// With F = Pᵀ L D Lᵀ P the factorization of (A + εI)_BB, p_R = 0 is imposed by multipliers μ on the rows
 // R and the new rows D border the system:
 //   (A + εI)_BB p_B + A_BD p_D + E_R μ = c_B,   A_DB p_B + (A + εI)_DD p_D = c_D,   E_Rᵀ p_B = 0.
 // With U = [A_BD, E_R], p_B = F⁻¹(c_B − U y), and y = (p_D, μ) solves the small Schur system
