@@ -100,10 +100,12 @@ int IslandSolver::border(ActiveLoop& loop, const SparseMatrix& a, RowIndex row) 
   }
   ActiveLoop::Border w;
   loop.factor->forward_sparse(u, w.index, w.value);
-  // G_jk = w_jᵀ D⁻¹ w_k against every earlier border, by scattering D⁻¹ w into a dense vector.
+  // G_jk = w_jᵀ D⁻¹ w_k against every earlier border, by scattering D⁻¹ w into a dense vector (zero
+  // between calls: only w's entries are set, and cleared again below).
   const auto count = static_cast<Eigen::Index>(loop.borders.size());
-  Vector& scattered = loop.coupling;
-  scattered.setZero(static_cast<Eigen::Index>(loop.factor->rows()));
+  Vector& scattered = loop.scattered;
+  if (scattered.size() != static_cast<Eigen::Index>(loop.factor->rows()))
+    scattered.setZero(static_cast<Eigen::Index>(loop.factor->rows()));
   double self = 0.0;
   for (std::size_t q = 0; q < w.index.size(); ++q) {
     const double scaled = w.value[q] * loop.factor->pivot_inverse(w.index[q]);
@@ -118,6 +120,7 @@ int IslandSolver::border(ActiveLoop& loop, const SparseMatrix& a, RowIndex row) 
     loop.gram(j, count) = loop.gram(count, j) = dot;
   }
   loop.gram(count, count) = self;
+  for (const int i : w.index) scattered(i) = 0.0;
   loop.borders.push_back(std::move(w));
   loop.border_of[row] = static_cast<int>(count);
   return static_cast<int>(count);

@@ -157,7 +157,8 @@ class IslandSolver {
     std::vector<RowIndex> added, removed;
     std::vector<int> slots;
     Eigen::FullPivLU<Eigen::MatrixXd> schur;
-    Vector forward, coupling;         // apply_update's workspace
+    Vector forward;                   // apply_update's t = L⁻¹ P c
+    Vector scattered;                 // border()'s D⁻¹ w, zero between calls
 
     void refactored();                // forgets the borders and the update of the old factorization
   };
