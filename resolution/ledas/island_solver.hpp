@@ -64,6 +64,10 @@ struct SolverSettings {
   /// Complementarity problems: the larger ε = this × max A_kk of the active-set search once the start set
   /// turned out not to be the answer (solve_complementarity); at most `regularization` disables it.
   double search_regularization = 1e-3;
+  /// Complementarity problems: the exact solve on a candidate free set (conjugate gradients preconditioned
+  /// by the search's factorization) may refactor at a smaller shift when it predicts that cheaper than
+  /// the steps it would take (refine_on_free_set).
+  bool sharpen_refinement = true;
 };
 
 /// What the solver did, accumulated over calls (reset by the caller).
@@ -86,6 +90,7 @@ struct SolverStats {
   std::uint64_t polished = 0;     ///< complementarity solutions replaced by the minimum-norm split
   std::uint64_t proximal = 0;     ///< proximal outer iterations after the first
   std::uint64_t refinements = 0;  ///< conjugate-gradient steps of exact solves on a candidate free set
+  std::uint64_t sharpened = 0;    ///< refinements that refactored at a smaller shift (fewer steps)
 };
 
 /// One island's complementarity problem: find p with w = A p − c and

@@ -148,6 +148,7 @@ LedasSettings LedasSettings::from_options(const ModuleOptions& options) {
   s.solver.regularization = options.number("regularization", s.solver.regularization, 1e-16, 1e-2);
   s.solver.search_regularization =
       options.number("search_regularization", s.solver.search_regularization, 0.0, 1e-1);
+  s.solver.sharpen_refinement = options.boolean("sharpen_refinement", s.solver.sharpen_refinement);
   s.solver.max_iterations = s.max_rounds;
   s.islands = options.boolean("islands", s.islands);
   s.resting = resolution::RestingSettings::from_options(options);
