@@ -442,9 +442,12 @@ IslandSolver::Refinement IslandSolver::refine_on_free_set(const SparseMatrix& a,
   solved_rows.resize(m);
   for (std::size_t k = 0; k < m; ++k)
     solved_rows[k] = free_rows[k] && work_.diagonal(static_cast<Eigen::Index>(k)) > loop.floor;
+  std::vector<Eigen::Index>& unsolved = work_.unsolved_rows;  // zeroed by index: no branch per row
+  unsolved.clear();
+  for (std::size_t k = 0; k < m; ++k)
+    if (!solved_rows[k]) unsolved.push_back(static_cast<Eigen::Index>(k));
   const auto restrict_to_base = [&](Vector& v) {
-    for (std::size_t k = 0; k < m; ++k)
-      if (!solved_rows[k]) v(static_cast<Eigen::Index>(k)) = 0.0;
+    for (const Eigen::Index k : unsolved) v(k) = 0.0;
   };
   restrict_to_base(x);
   residual.noalias() = -(a * x);
@@ -459,9 +462,10 @@ IslandSolver::Refinement IslandSolver::refine_on_free_set(const SparseMatrix& a,
   const double step_cost = 2.0 * static_cast<double>(loop.factor->capacity()) + static_cast<double>(a.nonZeros()) +
                            10.0 * static_cast<double>(m);
   double first_residual = 0.0;
+  const double size_c = c.lpNorm<Eigen::Infinity>();
   bool solved = false;
   for (int step = 0; step <= kMaxRefinementSteps; ++step) {
-    const double rounding = 1e-14 * (scale * x.lpNorm<Eigen::Infinity>() + c.lpNorm<Eigen::Infinity>());
+    const double rounding = 1e-14 * (scale * x.lpNorm<Eigen::Infinity>() + size_c);
     const double goal = std::max(1e-3 * problem.tolerance, rounding);
     const double size = residual.lpNorm<Eigen::Infinity>();
     if (size <= goal) {

@@ -174,6 +174,7 @@ class IslandSolver {
     Vector diagonal;  // A_kk of the complementarity problem being solved
     Vector residual, preconditioned, direction, product;  // refine_on_free_set
     std::vector<char> solved_rows;
+    std::vector<Eigen::Index> unsolved_rows;
   };
 
   Vector solve_active(const SparseMatrix& a, double shift, const Vector& r, const std::vector<char>& active,
