@@ -46,10 +46,9 @@ class InverseInertiaCache {
   const Mat3& get(std::span<const RigidBody> bodies, BodyIndex index) {
     if (generation_of_[index] != generation_) {
       generation_of_[index] = generation_;
-      // RigidBody::inv_inertia_world's expression (keep them equal), evaluated in place: copying the
-      // returned matrix in cost a failed store forwarding per body, a quarter of a row's set-up.
-      const RigidBody& body = bodies[index];
-      matrix_[index].noalias() = body.rotation * body.inv_inertia_body * body.rotation.transpose();
+      // Evaluated in place: copying a returned matrix in cost a failed store forwarding per body, a
+      // quarter of a row's set-up.
+      bodies[index].inv_inertia_world(matrix_[index]);
     }
     return matrix_[index];
   }
@@ -96,18 +95,9 @@ inline double coupling(const ImpulseRow& i, const ImpulseRow& k) {
 /// A_kk = 1/m_eff of a single row: n·n/M_a + (r_a×n)·J_a⁻¹(r_a×n) + the same for b.
 inline double self_coupling(const ImpulseRow& row) { return coupling(row, row); }
 
-/// Velocity of the material point of `body` at world `point` (m/s): RigidBody::velocity_at, bit for bit,
-/// with the lever arm r = p − x named first. GCC compiles velocity_at's nested Eigen expression through
-/// the stack (two scalar stores read back as one vector: a failed store forwarding), which tripled the
-/// cost of a row's velocity, the resolvers' most frequent evaluation.
-inline Vec3 point_velocity(const RigidBody& body, const Vec3& point) {
-  const Vec3 arm = point - body.position;
-  return body.velocity + body.angular_velocity.cross(arm);
-}
-
 /// v_n = (u_b − u_a)·n of the row at the bodies' current velocities (m/s; < 0 approaches).
 inline double row_velocity(const ImpulseRow& row, std::span<const RigidBody> bodies) {
-  return (point_velocity(bodies[row.b], row.point) - point_velocity(bodies[row.a], row.point)).dot(row.normal);
+  return (bodies[row.b].velocity_at(row.point) - bodies[row.a].velocity_at(row.point)).dot(row.normal);
 }
 
 /// Applies impulse magnitude `p` along the row (eq. 3): −p n on a, +p n on b. Fixed bodies unchanged.

@@ -43,7 +43,7 @@ struct RowInfo {
 /// For a contact (point_b = point) it is resolution::row_velocity. Inline: evaluated for every row twice
 /// per round.
 inline double row_velocity(const resolution::ImpulseRow& row, const RowInfo& info, std::span<const RigidBody> bodies) {
-  return (resolution::point_velocity(bodies[row.b], info.point_b) - resolution::point_velocity(bodies[row.a], row.point))
+  return (bodies[row.b].velocity_at(info.point_b) - bodies[row.a].velocity_at(row.point))
       .dot(row.normal);
 }
 

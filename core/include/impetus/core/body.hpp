@@ -56,9 +56,20 @@ struct RigidBody {
   /// J_world = R J_body Rᵀ (kg·m²).
   Mat3 inertia_world() const { return rotation * inertia_body * rotation.transpose(); }
   /// J_world⁻¹ = R J_body⁻¹ Rᵀ (zero for a fixed body).
-  Mat3 inv_inertia_world() const { return rotation * inv_inertia_body * rotation.transpose(); }
-  /// Velocity of the material point at world position `p`: u = v + ω × (p − x).
-  Vec3 velocity_at(const Vec3& p) const { return velocity + angular_velocity.cross(p - position); }
+  Mat3 inv_inertia_world() const {
+    Mat3 out;
+    inv_inertia_world(out);
+    return out;
+  }
+  /// The same, evaluated in place (a cache of them: no copy through the stack).
+  void inv_inertia_world(Mat3& out) const { out.noalias() = rotation * inv_inertia_body * rotation.transpose(); }
+  /// Velocity of the material point at world position `p`: u = v + ω × r, r = p − x. The lever arm is
+  /// named first: GCC compiles the nested expression through the stack (two scalar stores read back as
+  /// one vector, a failed store forwarding), which tripled the cost of the resolvers' most frequent call.
+  Vec3 velocity_at(const Vec3& p) const {
+    const Vec3 arm = p - position;
+    return velocity + angular_velocity.cross(arm);
+  }
   /// Orientation as a unit quaternion (w, x, y, z).
   Quat orientation() const { return Quat(rotation).normalized(); }
 };
