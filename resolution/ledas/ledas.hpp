@@ -42,8 +42,8 @@ struct LedasSettings {
   /// Cap on rounds per island (paper mode; restitution rounds in complementary mode) and on active-set
   /// iterations per complementarity problem; reaching it counts in non_converged. Option `max_rounds`.
   std::uint64_t max_rounds = 1000000;
-  /// Options `dense_limit`, `rank_tolerance`, `update_limit`, `regularization`, `search_regularization`
-  /// (max_iterations is set to max_rounds).
+  /// Options `dense_limit`, `polish_limit`, `rank_tolerance`, `update_limit`, `regularization`,
+  /// `search_regularization`, `sharpen_refinement` (max_iterations is set to max_rounds).
   ledas::SolverSettings solver;
   /// Solve each island (rows connected through movable bodies) on its own (default), or every row in
   /// one system (`islands: false`: the same velocities up to rounding, with the bounce threshold judged

@@ -200,11 +200,15 @@ TEST(LedasWorld, OptionsAreReadAndChecked) {
   set("slop", "2e-4");
   set("correction", "0.5");
   set("bounce_threshold", "0.1");
+  set("search_regularization", "1e-4");
+  set("sharpen_refinement", "false");
   const LedasSettings s = LedasSettings::from_options(options);
   EXPECT_TRUE(options.unread().empty());
   EXPECT_EQ(s.mode, LedasMode::paper);
   EXPECT_EQ(s.max_rounds, 500u);
   EXPECT_EQ(s.solver.dense_limit, 32u);
+  EXPECT_DOUBLE_EQ(s.solver.search_regularization, 1e-4);
+  EXPECT_FALSE(s.solver.sharpen_refinement);
   EXPECT_DOUBLE_EQ(s.resting.correction, 0.5);
   set("mode", "sequential");
   EXPECT_THROW(LedasSettings::from_options(options), OptionError);
