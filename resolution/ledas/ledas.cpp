@@ -118,6 +118,17 @@ struct LedasResolver::Island {
   // changes the island's body velocities without recomputing it).
   Vector velocity;
   bool velocity_current = false;
+
+  // complementarity = max over contact rows of |Σ p · (v_n − target)| at velocities v (after an
+  // inelastic phase). Accumulated in a local: the member would be kept in memory through the loop.
+  void measure_complementarity(const Vector& v, const Vector& target_now) {
+    double worst = 0.0;
+    for (std::size_t i = 0; i < rows.size(); ++i) {
+      const auto ei = static_cast<Eigen::Index>(i);
+      if (!equality[i]) worst = std::max(worst, std::abs(impulse_inelastic(ei) * (v(ei) - target_now(ei))));
+    }
+    complementarity = worst;
+  }
 };
 
 // The rows' velocities v_n (eq. 5) at the bodies' current velocities, recomputed only when stale.
@@ -419,15 +430,6 @@ void LedasResolver::velocity_paper(Island& island, std::span<RigidBody> bodies, 
   Vector target = island.target, rhs = Vector::Zero(static_cast<Eigen::Index>(m)), p = rhs;
   std::vector<RowIndex> subset;
   subset.reserve(m);
-  const auto measure_complementarity = [&] {  // after an inelastic phase, over every contact
-    double complementarity = 0.0;  // a local: island.complementarity would be kept in memory
-    for (std::size_t i = 0; i < m; ++i) {
-      const auto ei = static_cast<Eigen::Index>(i);
-      if (!island.equality[i])
-        complementarity = std::max(complementarity, std::abs(island.impulse_inelastic(ei) * (v(ei) - target(ei))));
-    }
-    island.complementarity = complementarity;
-  };
   for (std::uint64_t round = 0;; ++round) {
     const bool refine_joints = position_joints && retarget_joints(island, v, bodies) && round > 0;
     for (RowIndex i : subset) target(i) = island.target(i);  // last round's solve targets
@@ -469,7 +471,7 @@ void LedasResolver::velocity_paper(Island& island, std::span<RigidBody> bodies, 
     mark_moved(subset);
     refresh();
     if (bouncing) {
-      measure_complementarity();
+      island.measure_complementarity(v, target);
       for (RowIndex i : subset)
         if (island.restitution(i) != 0.0) resolution::apply_row_impulse(rows_[island.rows[i]], island.restitution(i) * p(i), bodies);
       refresh();
@@ -481,7 +483,7 @@ void LedasResolver::velocity_paper(Island& island, std::span<RigidBody> bodies, 
     ++island.rounds;
   }
   // Without restitution the state after the last inelastic phase is the final one.
-  if (!bouncing && island.rounds > 0) measure_complementarity();
+  if (!bouncing && island.rounds > 0) island.measure_complementarity(v, target);
 }
 
 // The exact impact (a linear complementarity problem), then (1 + e) p. Restitution can make a contact
@@ -534,13 +536,7 @@ void LedasResolver::finish_round(Island& island, const Vector& p, const Vector& 
   island.impulse_inelastic += p;
   island.velocity_current = false;
   const Vector& v = current_velocities(island, bodies);
-  double complementarity = 0.0;  // a local: island.complementarity would be kept in memory
-  for (std::size_t i = 0; i < m; ++i) {
-    const auto ei = static_cast<Eigen::Index>(i);
-    if (!island.equality[i])
-      complementarity = std::max(complementarity, std::abs(island.impulse_inelastic(ei) * (v(ei) - target(ei))));
-  }
-  island.complementarity = complementarity;
+  island.measure_complementarity(v, target);
   for (std::size_t i = 0; i < m; ++i) {
     const auto ei = static_cast<Eigen::Index>(i);
     if (island.restitution(ei) != 0.0) {
