@@ -4,6 +4,7 @@
 #include <array>
 #include <cmath>
 #include <limits>
+#include <span>
 #include <string>
 #include <utility>
 
@@ -25,38 +26,56 @@ constexpr double kPositionTolerance = 1e-12;
 // or stops halving.
 constexpr double kJointTolerance = 1e-9;
 
+// Which movable bodies an island's rows join, both ways: per row its bodies' slots in the island's
+// list of movable bodies (−1 for a fixed body), per body its rows (local indices, increasing; a row
+// joining a body to itself listed once). Built once per island; the matrix, the paper mode's stale-row
+// tracking and the complementary mode's start set read it.
+struct Incidence {
+  std::vector<std::array<std::int32_t, 2>> slots;
+  std::vector<std::uint32_t> body_start, body_rows;
+
+  Incidence() = default;
+  Incidence(std::span<const ImpulseRow> rows, std::span<const std::uint32_t> island, std::size_t movable,
+            std::span<const std::int32_t> slot_of_body) {
+    const std::size_t m = island.size();
+    slots.resize(m);
+    body_start.assign(movable + 1, 0);
+    for (std::size_t i = 0; i < m; ++i) {
+      const ImpulseRow& r = rows[island[i]];
+      slots[i] = {slot_of_body[r.a], slot_of_body[r.b]};
+      for (std::size_t k = 0; k < 2; ++k)
+        if (listed(i, k)) ++body_start[static_cast<std::size_t>(slots[i][k]) + 1];
+    }
+    for (std::size_t s = 0; s < movable; ++s) body_start[s + 1] += body_start[s];
+    body_rows.resize(body_start.back());
+    std::vector<std::uint32_t> fill(body_start.begin(), body_start.end() - 1);
+    for (std::size_t i = 0; i < m; ++i)
+      for (std::size_t k = 0; k < 2; ++k)
+        if (listed(i, k)) body_rows[fill[static_cast<std::size_t>(slots[i][k])]++] = static_cast<std::uint32_t>(i);
+  }
+  // Whether row i's side k is a movable body not already listed for it as side 0.
+  bool listed(std::size_t i, std::size_t k) const { return slots[i][k] >= 0 && !(k == 1 && slots[i][0] == slots[i][1]); }
+  // The rows of body slot s.
+  std::span<const std::uint32_t> rows_of(std::int32_t s) const {
+    if (s < 0) return {};
+    return {body_rows.data() + body_start[static_cast<std::size_t>(s)],
+            body_rows.data() + body_start[static_cast<std::size_t>(s) + 1]};
+  }
+};
+
 // A of eq. 7 over an island's rows (local indices), both triangles stored. A_ik ≠ 0 only where rows i
 // and k share a movable body, so column k is the union of the row lists of k's (at most two) movable
-// bodies, written in compressed form directly (no triplets, no sort of pairs). `movable` lists the
-// island's movable bodies (increasing); `slot_of_body[b]` is b's index in it (−1 for a fixed body).
+// bodies, written in compressed form directly (no triplets, no sort of pairs).
 SparseMatrix assemble_matrix(std::span<const ImpulseRow> rows, std::span<const std::uint32_t> island,
-                             std::span<const BodyIndex> movable, std::span<const std::int32_t> slot_of_body) {
+                             const Incidence& incidence) {
   const std::size_t m = island.size();
-  std::vector<std::array<int, 2>> slots(m);
-  std::vector<int> start(movable.size() + 1, 0);
-  for (std::size_t i = 0; i < m; ++i) {
-    const ImpulseRow& r = rows[island[i]];
-    slots[i] = {slot_of_body[r.a], r.b == r.a ? -1 : slot_of_body[r.b]};
-    for (int s : slots[i])
-      if (s >= 0) ++start[static_cast<std::size_t>(s) + 1];
-  }
-  for (std::size_t s = 0; s < movable.size(); ++s) start[s + 1] += start[s];
-  std::vector<int> body_rows(static_cast<std::size_t>(start.back()));
-  {
-    std::vector<int> fill(start.begin(), start.end() - 1);
-    for (std::size_t i = 0; i < m; ++i)
-      for (int s : slots[i])
-        if (s >= 0) body_rows[static_cast<std::size_t>(fill[static_cast<std::size_t>(s)]++)] = static_cast<int>(i);
-  }
-  const auto list = [&](int s) {
-    if (s < 0) return std::span<const int>();
-    return std::span<const int>(body_rows.data() + start[static_cast<std::size_t>(s)],
-                                body_rows.data() + start[static_cast<std::size_t>(s) + 1]);
+  const auto list = [&](std::size_t k, std::size_t side) {
+    return incidence.listed(k, side) ? incidence.rows_of(incidence.slots[k][side]) : std::span<const std::uint32_t>();
   };
   const auto em = static_cast<Eigen::Index>(m);
   SparseMatrix a(em, em);
   std::size_t nonzeros = 0;
-  for (std::size_t k = 0; k < m; ++k) nonzeros += list(slots[k][0]).size() + list(slots[k][1]).size();
+  for (std::size_t k = 0; k < m; ++k) nonzeros += list(k, 0).size() + list(k, 1).size();
   a.resizeNonZeros(static_cast<Eigen::Index>(nonzeros));
   int* outer = a.outerIndexPtr();
   int* inner = a.innerIndexPtr();
@@ -64,15 +83,15 @@ SparseMatrix assemble_matrix(std::span<const ImpulseRow> rows, std::span<const s
   int q = 0;
   for (std::size_t k = 0; k < m; ++k) {
     outer[k] = q;
-    const std::span<const int> x = list(slots[k][0]), y = list(slots[k][1]);
+    const std::span<const std::uint32_t> x = list(k, 0), y = list(k, 1);
     std::size_t u = 0, v = 0;
     while (u < x.size() || v < y.size()) {  // merge two increasing lists; rows sharing both bodies once
-      int i;
+      std::uint32_t i;
       if (v == y.size() || (u < x.size() && x[u] < y[v])) i = x[u++];
       else if (u == x.size() || y[v] < x[u]) i = y[v++];
       else i = x[u++], ++v;
-      inner[q] = i;
-      value[q] = resolution::coupling(rows[island[static_cast<std::size_t>(i)]], rows[island[k]]);
+      inner[q] = static_cast<int>(i);
+      value[q] = resolution::coupling(rows[island[i]], rows[island[k]]);
       ++q;
     }
   }
@@ -103,6 +122,7 @@ struct LedasResolver::Island {
   std::vector<std::uint32_t> rows;
   SparseMatrix a;                  // eq. 7
   std::vector<BodyIndex> bodies;   // movable bodies
+  Incidence incidence;             // rows ↔ movable bodies (slots in `bodies`)
   std::vector<char> equality;      // joint rows
   Vector target;                   // v_n⁺ bound: min(0, depth)/dt for contacts, RowInfo::target for joints
   Vector restitution;              // effective e per row (0 for joint rows)
@@ -288,7 +308,8 @@ LedasResolver::Island LedasResolver::make_island(std::vector<std::uint32_t> rows
       }
   std::sort(island.bodies.begin(), island.bodies.end());
   for (std::size_t s = 0; s < island.bodies.size(); ++s) body_slot_[island.bodies[s]] = static_cast<std::int32_t>(s);
-  island.a = assemble_matrix(rows_, island.rows, island.bodies, body_slot_);
+  island.incidence = Incidence(rows_, island.rows, island.bodies.size(), body_slot_);
+  island.a = assemble_matrix(rows_, island.rows, island.incidence);
   island.equality.resize(m);
   island.target.resize(em);
   island.restitution = Vector::Zero(em);
@@ -356,37 +377,14 @@ void LedasResolver::velocity_paper(Island& island, std::span<RigidBody> bodies, 
   const std::size_t m = island.rows.size();
   const std::size_t nb = island.bodies.size();
   island.velocity_current = false;  // the rounds keep their own velocities
-  // Per row: its movable bodies' slots in island.bodies (−1 for a fixed body) and the fixed bodies'
-  // share of v_n. Per body: its rows (local indices).
-  std::vector<std::array<std::int32_t, 2>> slots(m);
+  // Per row: the fixed bodies' share of v_n.
+  const auto& slots = island.incidence.slots;
   std::vector<double> fixed_share(m, 0.0);
-  std::vector<std::uint32_t> body_start(nb + 1, 0), body_rows;
   for (std::size_t i = 0; i < m; ++i) {
     const ImpulseRow& r = rows_[island.rows[i]];
     const ledas::RowInfo& ri = info_[island.rows[i]];
-    int k = 0;
-    for (BodyIndex body : {r.a, r.b}) {
-      const bool is_b = k == 1;
-      if (bodies[body].fixed) {
-        slots[i][static_cast<std::size_t>(k)] = -1;
-        const double u = bodies[body].velocity_at(is_b ? ri.point_b : r.point).dot(r.normal);
-        fixed_share[i] += is_b ? u : -u;
-      } else {
-        const std::int32_t s = body_slot_[body];
-        slots[i][static_cast<std::size_t>(k)] = s;
-        if (!(is_b && r.a == r.b)) ++body_start[static_cast<std::size_t>(s) + 1];
-      }
-      ++k;
-    }
-  }
-  for (std::size_t s = 0; s < nb; ++s) body_start[s + 1] += body_start[s];
-  body_rows.resize(body_start.back());
-  {
-    std::vector<std::uint32_t> fill(body_start.begin(), body_start.end() - 1);
-    for (std::size_t i = 0; i < m; ++i)
-      for (int k = 0; k < 2; ++k)
-        if (const std::int32_t s = slots[i][static_cast<std::size_t>(k)]; s >= 0 && !(k == 1 && slots[i][0] == s))
-          body_rows[fill[static_cast<std::size_t>(s)]++] = static_cast<std::uint32_t>(i);
+    if (slots[i][0] < 0) fixed_share[i] -= bodies[r.a].velocity_at(r.point).dot(r.normal);
+    if (slots[i][1] < 0) fixed_share[i] += bodies[r.b].velocity_at(ri.point_b).dot(r.normal);
   }
   const auto velocity = [&](std::size_t i) {
     const ImpulseRow& r = rows_[island.rows[i]];
@@ -414,8 +412,8 @@ void LedasResolver::velocity_paper(Island& island, std::span<RigidBody> bodies, 
       for (const std::int32_t s : slots[i]) {
         if (s < 0 || body_stamp[static_cast<std::size_t>(s)] == stamp) continue;
         body_stamp[static_cast<std::size_t>(s)] = stamp;
-        for (std::uint32_t k = body_start[static_cast<std::size_t>(s)]; k < body_start[static_cast<std::size_t>(s) + 1]; ++k)
-          if (const std::uint32_t row = body_rows[k]; row_stamp[row] != stamp) {
+        for (const std::uint32_t row : island.incidence.rows_of(s))
+          if (row_stamp[row] != stamp) {
             row_stamp[row] = stamp;
             stale.push_back(row);
           }
