@@ -33,6 +33,17 @@ enum class LedasMode : std::uint8_t {
   complementary
 };
 
+/// Which touching contacts the complementary mode's active-set search starts with (README.md, "The
+/// start set"). Only the first guess of the active set: the answer is the same either way.
+enum class LedasStartSet : std::uint8_t {
+  /// Approaching contacts, and the touching ones that can pass the impact on: to a fixed body, or
+  /// between two bodies at different distances (contact hops) from the impact. A touching contact across
+  /// the impact's front (between bodies at the same distance) mostly separates, so it starts out.
+  impact,
+  /// Every approaching or touching contact.
+  touching
+};
+
 /// Configuration (read once from the plugin's options).
 struct LedasSettings {
   LedasMode mode = LedasMode::complementary;  ///< option `mode: paper | complementary`
@@ -42,6 +53,8 @@ struct LedasSettings {
   /// Cap on rounds per island (paper mode; restitution rounds in complementary mode) and on active-set
   /// iterations per complementarity problem; reaching it counts in non_converged. Option `max_rounds`.
   std::uint64_t max_rounds = 1000000;
+  /// Complementary mode: the active-set search's first guess. Option `start_set: impact | touching`.
+  LedasStartSet start_set = LedasStartSet::impact;
   /// Options `dense_limit`, `polish_limit`, `rank_tolerance`, `update_limit`, `regularization`,
   /// `search_regularization`, `sharpen_refinement` (max_iterations is set to max_rounds).
   ledas::SolverSettings solver;
@@ -113,6 +126,7 @@ class LedasResolver final : public CollisionResolver {
   const ledas::Vector& current_velocities(Island& island, std::span<const RigidBody> bodies) const;
   void velocity_paper(Island& island, std::span<RigidBody> bodies, ResolverCounters& counters);
   void velocity_complementary(Island& island, std::span<RigidBody> bodies, ResolverCounters& counters);
+  void narrow_start_set(const Island& island, const ledas::Vector& v, std::vector<char>& start);
   bool retarget_joints(Island& island, const ledas::Vector& v, std::span<const RigidBody> bodies) const;
   void finish_round(Island& island, const ledas::Vector& p, const ledas::Vector& target, std::span<RigidBody> bodies);
   void correct_positions(Island& island, std::span<RigidBody> bodies);
@@ -124,6 +138,7 @@ class LedasResolver final : public CollisionResolver {
   std::vector<ledas::RowInfo> info_;
   resolution::InverseInertiaCache inertia_;  // the bodies' J⁻¹ while this step's rows are built
   std::vector<std::int32_t> body_slot_;  // per body: its slot in the current island's movable bodies, or −1
+  std::vector<std::int32_t> hops_, queue_;  // narrow_start_set's distances and search queue (reused)
 };
 
 }  // namespace impetus

@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include <cstdio>
+#include <random>
 
 namespace impetus {
 namespace {
@@ -164,16 +165,18 @@ TEST(LedasSystems, BoxOnFivePointsSharesEqually) {
   }
 }
 
-// Pyramid K = 20 (rank-deficient: 590 contacts on 420 in-plane degrees of freedom) with and without the
-// minimum-norm polish of the complementary mode (tried on final systems of at most dense_limit rows:
-// 100000 vs 8): the same impulses and velocities (1e-9) — the proximal iteration's split among
-// redundant contacts stays at the minimum-norm one; resolving the same contact graph again reuses
-// every symbolic analysis.
+// Pyramid K = 20 (rank-deficient: 590 contacts on 420 in-plane degrees of freedom), started with every
+// touching contact so that the search meets the redundant rows, with and without the minimum-norm polish
+// of the complementary mode (tried on final systems of at most dense_limit rows: 100000 vs 8): the same
+// impulses and velocities (1e-9) — the proximal iteration's split among redundant contacts stays at the
+// minimum-norm one; resolving the same contact graph again reuses every symbolic analysis.
 TEST(LedasSystems, SparseAndDensePathsAgree) {
   PyramidParams params;
   params.rows = 20;
   const std::vector<RigidBody> pyramid = make_pyramid(params);
-  LedasSettings sparse = settings_for(LedasMode::complementary), dense = sparse;
+  LedasSettings sparse = settings_for(LedasMode::complementary);
+  sparse.start_set = LedasStartSet::touching;
+  LedasSettings dense = sparse;
   sparse.solver.dense_limit = 8;
   dense.solver.dense_limit = 100000;
   const Outcome a = run(pyramid, sparse), b = run(pyramid, dense);
@@ -199,16 +202,19 @@ TEST(LedasSystems, SparseAndDensePathsAgree) {
               (unsigned long long)a.stats.velocity.singular, (unsigned long long)b.stats.velocity.polished);
 }
 
-// Pyramid K = 20 with the active-set search shift (search_regularization 1e-3, the default) and without
-// it (the tiny shift throughout): the velocities after the impact are unique, so they agree (1e-9), and
-// so do the impulses here (the final free set has no redundant rows: 400 rows on 420 degrees of
-// freedom); the search finds that set in at most 4 factorizations (3 here; 8 iterations and 4
-// factorizations without it).
+// Pyramid K = 20, started with every touching contact (so the search must release the 190 horizontal
+// ones), with the active-set search shift (search_regularization 1e-3, the default) and without it (the
+// tiny shift throughout): the velocities after the impact are unique, so they agree (1e-9), and so do
+// the impulses here (the final free set has no redundant rows: 400 rows on 420 degrees of freedom); the
+// search finds that set in at most 4 factorizations (2 here; 8 iterations and 4 factorizations without
+// it).
 TEST(LedasSystems, SearchShiftKeepsTheAnswer) {
   PyramidParams params;
   params.rows = 20;
   const std::vector<RigidBody> pyramid = make_pyramid(params);
-  LedasSettings searched = settings_for(LedasMode::complementary), plain = searched;
+  LedasSettings searched = settings_for(LedasMode::complementary);
+  searched.start_set = LedasStartSet::touching;
+  LedasSettings plain = searched;
   plain.solver.search_regularization = 0.0;
   const Outcome a = run(pyramid, searched), b = run(pyramid, plain);
   EXPECT_EQ(a.counters.non_converged, 0u);
@@ -227,16 +233,18 @@ TEST(LedasSystems, SearchShiftKeepsTheAnswer) {
               (unsigned long long)b.stats.velocity.sparse);
 }
 
-// Pyramid K = 50 (3 725 contacts), where the search shift's preconditioner would need many conjugate-
-// gradient steps (19 at K = 100, 12 here): the refinement refactors at a smaller shift once it predicts
-// that cheaper. The answer is unique in the velocities, so with and without that switch they agree to
-// 1e-9 m/s; both are exact (residual and complementarity error ≤ 1e-9), and the sharpened run takes
-// fewer steps.
+// Pyramid K = 50 (3 725 contacts) started with every touching contact, where the search shift's
+// preconditioner would need many conjugate-gradient steps (19 at K = 100, 12 here): the refinement
+// refactors at a smaller shift once it predicts that cheaper. The answer is unique in the velocities, so
+// with and without that switch they agree to 1e-9 m/s; both are exact (residual and complementarity
+// error ≤ 1e-9), and the sharpened run takes fewer steps.
 TEST(LedasSystems, SharpenedRefinementKeepsTheAnswerInFewerSteps) {
   PyramidParams params;
   params.rows = 50;
   const std::vector<RigidBody> pyramid = make_pyramid(params);
-  LedasSettings sharpened = settings_for(LedasMode::complementary), plain = sharpened;
+  LedasSettings sharpened = settings_for(LedasMode::complementary);
+  sharpened.start_set = LedasStartSet::touching;
+  LedasSettings plain = sharpened;
   plain.solver.sharpen_refinement = false;
   const Outcome a = run(pyramid, sharpened), b = run(pyramid, plain);
   for (const Outcome* o : {&a, &b}) {
@@ -252,6 +260,96 @@ TEST(LedasSystems, SharpenedRefinementKeepsTheAnswerInFewerSteps) {
   std::printf("[ledas] pyramid K=50: %llu refinement steps, %llu factorizations | without sharpening: %llu steps\n",
               (unsigned long long)a.stats.velocity.refinements, (unsigned long long)a.stats.velocity.sparse,
               (unsigned long long)b.stats.velocity.refinements);
+}
+
+// The start set (ledas.hpp, LedasStartSet): started with the impact's contacts, the pyramid's search has
+// nothing to release (its 190 / 1 225 horizontal contacts run across the impact's front and start out)
+// and solves in one factorization; started with every touching contact it releases them. The velocities
+// after the impact are unique, so the two agree (1e-9 m/s); both are exact (residual and complementarity
+// error ≤ 1e-9).
+TEST(LedasSystems, ImpactStartSetKeepsThePyramidsAnswer) {
+  for (int rows : {20, 50}) {
+    PyramidParams params;
+    params.rows = rows;
+    const std::vector<RigidBody> pyramid = make_pyramid(params);
+    LedasSettings impact = settings_for(LedasMode::complementary), touching = impact;
+    touching.start_set = LedasStartSet::touching;
+    const Outcome a = run(pyramid, impact), b = run(pyramid, touching);
+    for (const Outcome* o : {&a, &b}) {
+      EXPECT_EQ(o->counters.non_converged, 0u);
+      EXPECT_LE(o->counters.residual, 1e-9);
+      EXPECT_LE(o->counters.complementarity_error, 1e-9);
+    }
+    EXPECT_EQ(a.stats.velocity.sparse, 1u);
+    EXPECT_EQ(a.stats.velocity.released, 0u);
+    EXPECT_GE(b.stats.velocity.released, static_cast<std::uint64_t>(rows * (rows - 1) / 2));
+    ASSERT_EQ(a.bodies.size(), b.bodies.size());
+    for (std::size_t i = 0; i < a.bodies.size(); ++i) EXPECT_LT((a.bodies[i].velocity - b.bodies[i].velocity).norm(), 1e-9);
+  }
+}
+
+// A contact across the front that must push: P → L | R ← Q, four touching unit spheres in a line, the
+// ends moving inward at 1 m/s, e = 0. L and R are both struck (the same distance from the impact), so
+// L–R starts out of the impact's start set; the first solve leaves them approaching at 2 m/s and the
+// search adds it. Everything stops (momentum 0, every contact pushing: analytic), each contact's
+// impulse 1 N·s (1e-12).
+TEST(LedasSystems, ImpactStartSetAddsAContactAcrossTheFront) {
+  std::vector<RigidBody> bodies{sphere(0.5, 1, {0, 0, 0}, {1, 0, 0}), sphere(0.5, 1, {1, 0, 0}), sphere(0.5, 1, {2, 0, 0}),
+                                sphere(0.5, 1, {3, 0, 0}, {-1, 0, 0})};
+  std::vector<Contact> contacts = sphere_contacts(bodies);
+  ASSERT_EQ(contacts.size(), 3u);
+  LedasResolver resolver(settings_for(LedasMode::complementary));
+  const ResolverCounters c = resolve(resolver, bodies, contacts);
+  for (const RigidBody& b : bodies) EXPECT_LT(b.velocity.norm(), 1e-12);
+  for (const Contact& k : contacts) EXPECT_NEAR(k.impulse, 1.0, 1e-12);
+  EXPECT_GE(resolver.last_stats().velocity.added, 1u);
+  EXPECT_EQ(c.non_converged, 0u);
+}
+
+// Random touching clusters: a hexagonal patch of 19 spheres with random masses, moving together, struck
+// by two of its boundary spheres moving inward at random velocities (200 trials, e = 0 and 1). The
+// impact's start set and every touching contact give the same velocities (1e-9 m/s), both exact.
+TEST(LedasSystems, ImpactStartSetKeepsTheAnswerOnRandomClusters) {
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  int added = 0, released = 0, iterations[2] = {0, 0}, factorizations[2] = {0, 0};
+  for (int trial = 0; trial < 200; ++trial) {
+    const double e = trial % 2 == 0 ? 0.0 : 1.0;
+    const Vec3 drift(u(rng), u(rng), 0.0);
+    std::vector<RigidBody> bodies;
+    for (int q = -2; q <= 2; ++q)
+      for (int r = -2; r <= 2; ++r) {
+        if (std::abs(q + r) > 2) continue;
+        const Vec3 x(q + 0.5 * r, r * std::sqrt(3.0) / 2.0, 0.0);
+        bodies.push_back(sphere(0.5, 1.5 + u(rng), x, drift, e));
+      }
+    ASSERT_EQ(bodies.size(), 19u);
+    for (int strikers = 0; strikers < 2; ++strikers) {
+      RigidBody* outer = nullptr;
+      while (outer == nullptr || outer->position.norm() < 1.5) outer = &bodies[static_cast<std::size_t>(rng() % bodies.size())];
+      const Vec3 inward = -outer->position.normalized();
+      outer->velocity = drift + (1.0 + u(rng)) * inward + 0.5 * u(rng) * Vec3(-inward.y(), inward.x(), 0.0);
+    }
+    Outcome out[2];
+    for (int k = 0; k < 2; ++k) {
+      LedasSettings settings = settings_for(LedasMode::complementary);
+      settings.start_set = k == 0 ? LedasStartSet::impact : LedasStartSet::touching;
+      out[k] = run(bodies, settings);
+      EXPECT_EQ(out[k].counters.non_converged, 0u);
+      EXPECT_LE(out[k].counters.residual, 1e-9);
+    }
+    for (int k = 0; k < 2; ++k) {
+      iterations[k] += static_cast<int>(out[k].stats.velocity.iterations);
+      factorizations[k] += static_cast<int>(out[k].stats.velocity.sparse);
+    }
+    added += static_cast<int>(out[0].stats.velocity.added);
+    released += static_cast<int>(out[1].stats.velocity.released);
+    for (std::size_t i = 0; i < bodies.size(); ++i)
+      EXPECT_LT((out[0].bodies[i].velocity - out[1].bodies[i].velocity).norm(), 1e-9) << "trial " << trial;
+  }
+  std::printf("[ledas] 200 random struck clusters: impact start set %d iterations, %d factorizations, %d rows added | "
+              "touching start set %d iterations, %d factorizations, %d rows released\n",
+              iterations[0], factorizations[0], added, iterations[1], factorizations[1], released);
 }
 
 }  // namespace

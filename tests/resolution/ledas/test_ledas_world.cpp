@@ -202,6 +202,7 @@ TEST(LedasWorld, OptionsAreReadAndChecked) {
   set("bounce_threshold", "0.1");
   set("search_regularization", "1e-4");
   set("sharpen_refinement", "false");
+  set("start_set", "touching");
   const LedasSettings s = LedasSettings::from_options(options);
   EXPECT_TRUE(options.unread().empty());
   EXPECT_EQ(s.mode, LedasMode::paper);
@@ -209,8 +210,12 @@ TEST(LedasWorld, OptionsAreReadAndChecked) {
   EXPECT_EQ(s.solver.dense_limit, 32u);
   EXPECT_DOUBLE_EQ(s.solver.search_regularization, 1e-4);
   EXPECT_FALSE(s.solver.sharpen_refinement);
+  EXPECT_EQ(s.start_set, LedasStartSet::touching);
   EXPECT_DOUBLE_EQ(s.resting.correction, 0.5);
   set("mode", "sequential");
+  EXPECT_THROW(LedasSettings::from_options(options), OptionError);
+  set("mode", "paper");
+  set("start_set", "all");
   EXPECT_THROW(LedasSettings::from_options(options), OptionError);
 }
 
