@@ -65,7 +65,10 @@ struct Incidence {
 
 // A of eq. 7 over an island's rows (local indices), both triangles stored. A_ik ≠ 0 only where rows i
 // and k share a movable body, so column k is the union of the row lists of k's (at most two) movable
-// bodies, written in compressed form directly (no triplets, no sort of pairs).
+// bodies, written in compressed form directly (no triplets, no sort of pairs). Each coupling is
+// computed once, on and below the diagonal (i ≥ k); an entry above it (i < k) is copied from column i,
+// whose entries below the diagonal are met in increasing row order as k grows. So A is exactly
+// symmetric.
 SparseMatrix assemble_matrix(std::span<const ImpulseRow> rows, std::span<const std::uint32_t> island,
                              const Incidence& incidence) {
   const std::size_t m = island.size();
@@ -80,6 +83,7 @@ SparseMatrix assemble_matrix(std::span<const ImpulseRow> rows, std::span<const s
   int* outer = a.outerIndexPtr();
   int* inner = a.innerIndexPtr();
   double* value = a.valuePtr();
+  std::vector<int> below(m);  // per column: where its next entry below the diagonal goes
   int q = 0;
   for (std::size_t k = 0; k < m; ++k) {
     outer[k] = q;
@@ -91,7 +95,12 @@ SparseMatrix assemble_matrix(std::span<const ImpulseRow> rows, std::span<const s
       else if (u == x.size() || y[v] < x[u]) i = y[v++];
       else i = x[u++], ++v;
       inner[q] = static_cast<int>(i);
-      value[q] = resolution::coupling(rows[island[i]], rows[island[k]]);
+      if (i < k) {
+        value[q] = value[below[i]++];  // A_ik = A_ki, computed in column i
+      } else {
+        value[q] = resolution::coupling(rows[island[i]], rows[island[k]]);
+        if (i == k) below[k] = q + 1;
+      }
       ++q;
     }
   }
