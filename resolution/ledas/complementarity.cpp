@@ -167,6 +167,26 @@ void IslandSolver::apply_update(ActiveLoop& loop, const Vector& c, Vector& out) 
   for (Eigen::Index j = 0; j < nd; ++j) out(loop.added[static_cast<std::size_t>(j)]) = y(j);
 }
 
+// Factorizes (A + εI)_FF for the free rows F into the loop. The symbolic analysis covers the rows the
+// search was expected to need (its start set, MaskedLdlt::analyze); a free set beyond them is analysed
+// again first, once with the rows it adds, after that with every row (so at most two analyses more).
+void IslandSolver::factorize_loop(ActiveLoop& loop, const SparseMatrix& a, const std::vector<char>& rows, double shift,
+                                  SolverStats& stats) {
+  if (!loop.factor->covers(rows)) {
+    std::vector<char> wider(rows.size(), 1);
+    if (!loop.widened)
+      for (std::size_t k = 0; k < rows.size(); ++k) wider[k] = rows[k] || loop.factor->analysed(k);
+    loop.widened = true;
+    loop.factor->analyze(a, wider);
+    ++stats.symbolic_analyses;
+  }
+  ++stats.sparse;
+  loop.factor->factorize(a, rows, settings_.rank_tolerance, loop.floor, shift);
+  loop.factored = true;
+  loop.refactored();
+  for (std::size_t k = 0; k < rows.size(); ++k) loop.in_base[k] = rows[k] && !loop.factor->dropped(k);
+}
+
 // Solves (A + εI)_FF z = r_F for the free rows F: by the current factorization when F is the one it
 // holds, by an update when only a few rows changed, else by a new masked factorization (same symbolic
 // analysis). A + εI is positive definite, so every free set has exactly one solution.
@@ -186,12 +206,8 @@ Vector IslandSolver::solve_active(const SparseMatrix& a, double shift, const Vec
                                   : std::max<std::size_t>(8, static_cast<std::size_t>(std::sqrt(static_cast<double>(active.size()))));
     if (changes <= limit && solve_updated(loop, a, shift, r, active, z, stats)) return z;
   }
-  ++stats.sparse;
-  loop.factor->factorize(a, active, settings_.rank_tolerance, loop.floor, shift);
-  loop.factored = true;
-  loop.refactored();
+  factorize_loop(loop, a, active, shift, stats);
   loop.singular = loop.singular || loop.factor->redundant_rows(shift) > 0;
-  for (std::size_t k = 0; k < active.size(); ++k) loop.in_base[k] = active[k] && !loop.factor->dropped(k);
   Vector z = r;
   loop.factor->solve(z);
   return z;
@@ -259,7 +275,7 @@ Vector IslandSolver::solve_complementarity(const ComplementarityProblem& problem
   const double search_shift = std::max(final_shift, settings_.search_regularization * scale);
   double shift = final_shift;
   ActiveLoop loop;
-  loop.factor = checkout_masked(a, stats);
+  loop.factor = checkout_masked(a, free_rows, stats);
   loop.floor = settings_.rank_tolerance * scale;
   loop.in_base.assign(m, 0);
   Vector center = Vector::Zero(a.rows());  // p̄
@@ -417,14 +433,7 @@ IslandSolver::Refinement IslandSolver::refine_on_free_set(const SparseMatrix& a,
   for (std::size_t k = 0; holds && k < m; ++k)
     holds = free_rows[k] ? (loop.in_base[k] || loop.factor->dropped(k)) : !loop.in_base[k];
   bool by_update = !holds && loop.factored && loop.updated && loop.updated_for == free_rows;
-  const auto factorize_free_set = [&] {
-    ++stats.sparse;
-    loop.factor->factorize(a, free_rows, settings_.rank_tolerance, loop.floor, shift);
-    loop.factored = true;
-    loop.refactored();
-    for (std::size_t k = 0; k < m; ++k) loop.in_base[k] = free_rows[k] && !loop.factor->dropped(k);
-  };
-  if (!holds && !by_update) factorize_free_set();
+  if (!holds && !by_update) factorize_loop(loop, a, free_rows, shift, stats);
   Vector& residual = work_.residual;
   Vector& preconditioned = work_.preconditioned;
   Vector& direction = work_.direction;
@@ -483,7 +492,7 @@ IslandSolver::Refinement IslandSolver::refine_on_free_set(const SparseMatrix& a,
       if (remaining * step_cost >
           kFactorizationWeight * loop.factor->factorization_work() + kStepsAfterSharpening * step_cost) {
         shift = std::max(final_shift, kShiftReduction * shift);
-        factorize_free_set();
+        factorize_loop(loop, a, free_rows, shift, stats);
         loop.factored = false;  // at a shift the active-set loop is not using: refactor when it goes on
         by_update = false;
         ++stats.sharpened;

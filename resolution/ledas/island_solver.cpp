@@ -60,7 +60,8 @@ void IslandSolver::checkin(FactorPtr factor) {
   if (cache_.size() > kCacheCapacity) cache_.erase(cache_.begin());
 }
 
-std::unique_ptr<MaskedLdlt> IslandSolver::checkout_masked(const SparseMatrix& m, SolverStats& stats) {
+std::unique_ptr<MaskedLdlt> IslandSolver::checkout_masked(const SparseMatrix& m, std::span<const char> likely,
+                                                         SolverStats& stats) {
   for (auto it = masked_cache_.begin(); it != masked_cache_.end(); ++it) {
     if ((*it)->same_pattern(m)) {
       std::unique_ptr<MaskedLdlt> f = std::move(*it);
@@ -70,7 +71,7 @@ std::unique_ptr<MaskedLdlt> IslandSolver::checkout_masked(const SparseMatrix& m,
     }
   }
   auto f = std::make_unique<MaskedLdlt>();
-  f->analyze(m);
+  f->analyze(m, likely);
   ++stats.symbolic_analyses;
   return f;
 }

@@ -144,6 +144,7 @@ class IslandSolver {
     bool factored = false;
     double floor = 0.0;               // A_kk at or below this: nothing movable behind row k
     bool singular = false;            // a factorization met a redundant row (pivot ≈ the shift)
+    bool widened = false;             // the analysis was redone for rows beyond the start set
     std::vector<char> in_base;        // rows of the last factorization (free and not dropped)
     // Border columns of the updates against the last factorization (solve_updated): per row that
     // joined or left F, w = L⁻¹ P u (sparse), and the Gram matrix G_ij = w_iᵀ D⁻¹ w_j of those
@@ -177,6 +178,8 @@ class IslandSolver {
     std::vector<Eigen::Index> unsolved_rows;
   };
 
+  void factorize_loop(ActiveLoop& loop, const SparseMatrix& a, const std::vector<char>& rows, double shift,
+                      SolverStats& stats);
   Vector solve_active(const SparseMatrix& a, double shift, const Vector& r, const std::vector<char>& active,
                       ActiveLoop& loop, SolverStats& stats);
   enum class Refinement { exact, infeasible, not_converged };
@@ -194,7 +197,10 @@ class IslandSolver {
                            const ComplementarityProblem& problem, Vector& p, SolverStats& stats);
   FactorPtr checkout(const SparseMatrix& m, SolverStats& stats);
   void checkin(FactorPtr factor);
-  std::unique_ptr<MaskedLdlt> checkout_masked(const SparseMatrix& m, SolverStats& stats);
+  /// A masked factorization of m's pattern: the cached one if there is one (analysed for the rows of an
+  /// earlier start set: factorize_loop widens it when a free set needs more), else a new analysis for
+  /// the rows `likely` to be free (the start set; MaskedLdlt::analyze).
+  std::unique_ptr<MaskedLdlt> checkout_masked(const SparseMatrix& m, std::span<const char> likely, SolverStats& stats);
   void checkin_masked(std::unique_ptr<MaskedLdlt> factor);
 
   SolverSettings settings_;

@@ -7,23 +7,58 @@
 
 namespace impetus::ledas {
 
-void MaskedLdlt::analyze(const Matrix& a) {
+// Approximate minimum degree (Eigen's port of AMD, as SimplicialLDLT uses): order[new] = old.
+std::vector<int> MaskedLdlt::minimum_degree(const Matrix& a) {
+  std::vector<int> order(static_cast<std::size_t>(a.cols()));
+  if (a.cols() <= 2) {
+    std::iota(order.begin(), order.end(), 0);
+    return order;
+  }
+  Matrix symmetric = a;  // AMD needs both triangles and the diagonal; it destroys its input
+  Eigen::PermutationMatrix<Eigen::Dynamic, Eigen::Dynamic, int> perm;
+  Eigen::internal::minimum_degree_ordering(symmetric, perm);
+  for (std::size_t k = 0; k < order.size(); ++k) order[k] = perm.indices()[static_cast<Eigen::Index>(k)];
+  return order;
+}
+
+void MaskedLdlt::analyze(const Matrix& a, std::span<const char> rows) {
   const auto n = static_cast<int>(a.cols());
   outer_.assign(a.outerIndexPtr(), a.outerIndexPtr() + n + 1);
   inner_.assign(a.innerIndexPtr(), a.innerIndexPtr() + a.nonZeros());
+  analysed_.assign(static_cast<std::size_t>(n), 1);
+  if (!rows.empty())
+    for (int k = 0; k < n; ++k) analysed_[static_cast<std::size_t>(k)] = rows[static_cast<std::size_t>(k)] != 0;
+  const bool all = std::all_of(analysed_.begin(), analysed_.end(), [](char c) { return c != 0; });
 
-  // Fill-reducing order: approximate minimum degree (Eigen's port of AMD), as SimplicialLDLT does.
-  order_.resize(static_cast<std::size_t>(n));
-  if (n > 2) {
-    Matrix symmetric = a;  // AMD needs both triangles and the diagonal; it destroys its input
-    Eigen::PermutationMatrix<Eigen::Dynamic, Eigen::Dynamic, int> perm;
-    Eigen::internal::minimum_degree_ordering(symmetric, perm);
-    for (int k = 0; k < n; ++k) order_[static_cast<std::size_t>(k)] = perm.indices()[k];
+  // Fill-reducing order of the analysed rows (AMD on their pattern), the others after them.
+  if (all) {
+    order_ = minimum_degree(a);
   } else {
-    std::iota(order_.begin(), order_.end(), 0);
+    std::vector<int> kept, position(static_cast<std::size_t>(n), -1);
+    for (int k = 0; k < n; ++k)
+      if (analysed_[static_cast<std::size_t>(k)]) {
+        position[static_cast<std::size_t>(k)] = static_cast<int>(kept.size());
+        kept.push_back(k);
+      }
+    const auto nk = static_cast<Eigen::Index>(kept.size());
+    Matrix sub(nk, nk);  // A's pattern on the analysed rows
+    std::vector<Eigen::Triplet<double>> entries;
+    for (const int j : kept)
+      for (int p = outer_[static_cast<std::size_t>(j)]; p < outer_[static_cast<std::size_t>(j) + 1]; ++p)
+        if (const int i = position[static_cast<std::size_t>(inner_[static_cast<std::size_t>(p)])]; i >= 0)
+          entries.emplace_back(i, position[static_cast<std::size_t>(j)], 1.0);
+    sub.setFromTriplets(entries.begin(), entries.end());
+    order_.clear();
+    for (const int k : minimum_degree(sub)) order_.push_back(kept[static_cast<std::size_t>(k)]);
+    for (int k = 0; k < n; ++k)
+      if (!analysed_[static_cast<std::size_t>(k)]) order_.push_back(k);
   }
   new_of_old_.resize(static_cast<std::size_t>(n));
   for (int k = 0; k < n; ++k) new_of_old_[static_cast<std::size_t>(order_[static_cast<std::size_t>(k)])] = k;
+  // Only entries between analysed rows enter the pattern (the others are identity rows, never in F).
+  const auto entry = [&](int p, int j) {
+    return analysed_[static_cast<std::size_t>(inner_[static_cast<std::size_t>(p)])] && analysed_[static_cast<std::size_t>(j)];
+  };
 
   // Upper triangle of C = P A Pᵀ by columns: column k (new) holds rows i ≤ k.
   c_outer_.assign(static_cast<std::size_t>(n) + 1, 0);
@@ -31,7 +66,7 @@ void MaskedLdlt::analyze(const Matrix& a) {
     for (int p = outer_[static_cast<std::size_t>(j)]; p < outer_[static_cast<std::size_t>(j) + 1]; ++p) {
       const int i = new_of_old_[static_cast<std::size_t>(inner_[static_cast<std::size_t>(p)])];
       const int k = new_of_old_[static_cast<std::size_t>(j)];
-      if (i <= k) ++c_outer_[static_cast<std::size_t>(k) + 1];
+      if (i <= k && entry(p, j)) ++c_outer_[static_cast<std::size_t>(k) + 1];
     }
   std::partial_sum(c_outer_.begin(), c_outer_.end(), c_outer_.begin());
   c_row_.resize(static_cast<std::size_t>(c_outer_.back()));
@@ -41,7 +76,7 @@ void MaskedLdlt::analyze(const Matrix& a) {
     for (int p = outer_[static_cast<std::size_t>(j)]; p < outer_[static_cast<std::size_t>(j) + 1]; ++p) {
       const int i = new_of_old_[static_cast<std::size_t>(inner_[static_cast<std::size_t>(p)])];
       const int k = new_of_old_[static_cast<std::size_t>(j)];
-      if (i > k) continue;
+      if (i > k || !entry(p, j)) continue;
       const auto q = static_cast<std::size_t>(next[static_cast<std::size_t>(k)]++);
       c_row_[q] = i;
       c_value_[q] = p;
@@ -97,6 +132,12 @@ void MaskedLdlt::analyze(const Matrix& a) {
   visited_.assign(static_cast<std::size_t>(n), 0);
   reach_.clear();
   stamp_ = 0;
+}
+
+bool MaskedLdlt::covers(std::span<const char> on) const {
+  for (std::size_t k = 0; k < on.size(); ++k)
+    if (on[k] && !analysed_[k]) return false;
+  return true;
 }
 
 bool MaskedLdlt::same_pattern(const Matrix& a) const {

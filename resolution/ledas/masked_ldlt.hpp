@@ -30,13 +30,21 @@ class MaskedLdlt {
  public:
   using Matrix = Eigen::SparseMatrix<double>;
 
-  /// Symbolic analysis of the pattern of `a` (square, both triangles and the diagonal stored, compressed).
-  void analyze(const Matrix& a);
+  /// Symbolic analysis of the pattern of `a` (square, both triangles and the diagonal stored, compressed),
+  /// for the rows `rows` (non-zero; empty: every row) — only they may be in a later F (covers()). The
+  /// order is approximate minimum degree on their pattern, the other rows after them as identity rows:
+  /// an active-set search's likely rows (its start set) are factorized with their own fill, and rows
+  /// that mostly stay out of F (a pyramid's horizontal contacts) add nothing to the pattern.
+  void analyze(const Matrix& a, std::span<const char> rows = {});
+  /// Whether every row of F = {k : on[k] != 0} was analysed (else analyze again with them).
+  bool covers(std::span<const char> on) const;
+  /// Whether row k was analysed.
+  bool analysed(std::size_t k) const { return analysed_[k] != 0; }
   /// Whether `a` has the pattern analyze() was given.
   bool same_pattern(const Matrix& a) const;
 
-  /// Numeric factorization of A_FF, F = {k : on[k] != 0}; returns the number of dropped rows (see the
-  /// file comment). A row with A_kk ≤ floor (nothing movable behind it) is dropped too.
+  /// Numeric factorization of A_FF, F = {k : on[k] != 0} (rows analysed: covers(on)); returns the number
+  /// of dropped rows (see the file comment). A row with A_kk ≤ floor (nothing movable behind it) is dropped too.
   /// With `shift` > 0 it factorizes A_FF + shift·I instead (positive definite: only rows with
   /// A_kk ≤ floor are dropped).
   std::size_t factorize(const Matrix& a, std::span<const char> on, double rank_tolerance, double floor,
@@ -73,8 +81,10 @@ class MaskedLdlt {
 
  private:
   static constexpr char kOff = 0, kOn = 1, kDropped = 2;
+  static std::vector<int> minimum_degree(const Matrix& a);
 
-  std::vector<int> outer_, inner_;       // the analysed pattern of A
+  std::vector<int> outer_, inner_;       // the pattern of A
+  std::vector<char> analysed_;           // per row: in the analysed pattern (may be in F)
   std::vector<int> order_, new_of_old_;  // order_[new] = old
   // Upper triangle of P A Pᵀ by columns (rows i ≤ k), each entry pointing into A's value array.
   std::vector<int> c_outer_, c_row_, c_value_;

@@ -312,7 +312,7 @@ TEST(LedasSystems, ImpactStartSetAddsAContactAcrossTheFront) {
 TEST(LedasSystems, ImpactStartSetKeepsTheAnswerOnRandomClusters) {
   std::mt19937 rng(11);
   std::uniform_real_distribution<double> u(-1.0, 1.0);
-  int added = 0, released = 0, iterations[2] = {0, 0}, factorizations[2] = {0, 0};
+  int added = 0, released = 0, iterations[2] = {0, 0}, factorizations[2] = {0, 0}, analyses[2] = {0, 0};
   for (int trial = 0; trial < 200; ++trial) {
     const double e = trial % 2 == 0 ? 0.0 : 1.0;
     const Vec3 drift(u(rng), u(rng), 0.0);
@@ -341,15 +341,17 @@ TEST(LedasSystems, ImpactStartSetKeepsTheAnswerOnRandomClusters) {
     for (int k = 0; k < 2; ++k) {
       iterations[k] += static_cast<int>(out[k].stats.velocity.iterations);
       factorizations[k] += static_cast<int>(out[k].stats.velocity.sparse);
+      analyses[k] += static_cast<int>(out[k].stats.velocity.symbolic_analyses);
     }
     added += static_cast<int>(out[0].stats.velocity.added);
     released += static_cast<int>(out[1].stats.velocity.released);
     for (std::size_t i = 0; i < bodies.size(); ++i)
       EXPECT_LT((out[0].bodies[i].velocity - out[1].bodies[i].velocity).norm(), 1e-9) << "trial " << trial;
   }
-  std::printf("[ledas] 200 random struck clusters: impact start set %d iterations, %d factorizations, %d rows added | "
-              "touching start set %d iterations, %d factorizations, %d rows released\n",
-              iterations[0], factorizations[0], added, iterations[1], factorizations[1], released);
+  std::printf("[ledas] 200 random struck clusters: impact start set %d iterations, %d factorizations, %d symbolic "
+              "analyses, %d rows added | touching start set %d iterations, %d factorizations, %d analyses, %d rows "
+              "released\n",
+              iterations[0], factorizations[0], analyses[0], added, iterations[1], factorizations[1], analyses[1], released);
 }
 
 }  // namespace
