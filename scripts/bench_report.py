@@ -223,6 +223,8 @@ MODEL_TEXT = {
     "islands": "the same 16 pyramids solved island by island (on) or as one system (off)",
     "primitives": "pyramid K = 10 of analytic spheres (on) or of 642-vertex convex icosphere meshes (off)",
     "contact_reduction": "10 boxes, each turned 45°: ≤ 4 points per pair (on) or all 8 octagon corners (off)",
+    "start_set": "pyramid K = 20 dropped on a fixed ground: ledas starts with the impact's contacts (on) or every "
+                 "touching one (off)",
 }
 
 
