@@ -661,8 +661,10 @@ void LedasResolver::correct_positions(Island& island, std::span<RigidBody> bodie
     if (island.equality[i]) continue;
     const double t = resolution::correction_target(info_[island.rows[i]].depth, settings_.resting);
     problem.rhs(static_cast<Eigen::Index>(i)) = t;
-    problem.start[i] = t > 0.0;
-    needed = needed || t > 0.0;
+    // q = 0 already meets a target within the problem's tolerance (w = −t ≥ −tolerance): a contact
+    // overlapping by the slop plus rounding (a generated pyramid at rest) asks for no solve.
+    problem.start[i] = t > kPositionTolerance;
+    needed = needed || t > kPositionTolerance;
   }
   if (!needed) return;
   const Vector q = solver_.solve_complementarity(problem, stats_.position);

@@ -187,6 +187,28 @@ TEST(LedasWorld, FallingBallDoesNotStopShortOfTheGround) {
   }
 }
 
+// The position correction asks only for what the problem's tolerance (1e-12 m) can see: a sphere at
+// rest on the ground overlapping by the slop plus rounding (1e-15 m more) gets no correction problem
+// and does not move; overlapping by 1e-6 m more it is pushed out by correction × 1e-6 m (1e-15).
+TEST(LedasWorld, PositionCorrectionSkipsRoundingAboveTheSlop) {
+  const LedasSettings settings = settings_for(LedasMode::complementary);
+  for (const double excess : {1e-15, 1e-6}) {
+    const double depth = settings.resting.slop + excess;
+    std::vector<RigidBody> bodies{ground_plane(), sphere(0.5, 1.0, {0, 0, 0.5 - depth})};
+    std::vector<Contact> contacts{contact(0, 1, {0, 0, -depth}, Vec3::UnitZ(), depth)};
+    LedasResolver resolver(settings);
+    resolve(resolver, bodies, contacts);
+    const double moved = bodies[1].position.z() - (0.5 - depth);
+    if (excess < 1e-12) {
+      EXPECT_EQ(resolver.last_stats().position.iterations, 0u);
+      EXPECT_EQ(moved, 0.0);
+    } else {
+      EXPECT_GE(resolver.last_stats().position.iterations, 1u);
+      EXPECT_NEAR(moved, settings.resting.correction * excess, 1e-15);
+    }
+  }
+}
+
 // Options: every documented option is read; bad values are rejected with the option's name.
 TEST(LedasWorld, OptionsAreReadAndChecked) {
   ModuleOptions options("plugin 'ledas' (resolver)");
