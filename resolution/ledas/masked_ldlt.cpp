@@ -3,6 +3,7 @@
 #include <Eigen/OrderingMethods>
 
 #include <algorithm>
+#include <cassert>
 #include <numeric>
 
 namespace impetus::ledas {
@@ -152,6 +153,7 @@ bool MaskedLdlt::same_pattern(const Matrix& a) const {
 // Entries that come out exactly zero (a row of the full pattern that F does not reach) are not stored.
 std::size_t MaskedLdlt::factorize(const Matrix& a, std::span<const char> on, double rank_tolerance, double floor,
                                   double shift) {
+  assert(covers(on) && "a row of F outside the analysed pattern would be factorized as if uncoupled");
   const auto n = static_cast<int>(order_.size());
   const double* value = a.valuePtr();
   const int* c_outer = c_outer_.data();
