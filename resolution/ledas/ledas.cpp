@@ -441,10 +441,6 @@ void LedasResolver::velocity_paper(Island& island, std::span<RigidBody> bodies, 
   subset.reserve(m);
   for (std::size_t i = 0; i < m; ++i)
     if (island.equality[i]) joint_rows.push_back(static_cast<RowIndex>(i));
-  // The rows a round checks: every row in the first; after that the joint rows and the contacts the
-  // last round moved (its subset among them). Any other contact kept its velocity and did not approach
-  // (it would have been in the subset), so it does not now: a round costs O(rows it touches), not O(m)
-  // (line N = 10 000, e = 1: 19 999 rounds).
   // With restitution, complementarity is measured after each round's inelastic phase; only the last
   // round's counts, and only the rows that round moved differ from the final state, so their velocity
   // and target at that point are kept (inelastic_v, inelastic_target for the rows of moved_last).
@@ -459,7 +455,11 @@ void LedasResolver::velocity_paper(Island& island, std::span<RigidBody> bodies, 
     for (RowIndex i : subset) target(i) = island.target(i);  // last round's solve targets
     subset.clear();
     bool approaching = false, joint_violated = false;
-    // A scan of every row is cheaper than sorting the candidates unless they are few.
+    // The rows a round checks: every row in the first; after that the joint rows and the contacts the
+    // last round moved (its subset among them). Any other contact kept its velocity and did not
+    // approach (it would have been in the subset), so it does not now: a round costs O(rows it
+    // touches), not O(m) (line N = 10 000, e = 1: 19 999 rounds). A scan of every row is cheaper than
+    // sorting the candidates unless they are few.
     const std::size_t joints = joint_rows.size();
     const bool scan = round == 0 || 8 * (joints + stale.size()) >= m;
     const std::size_t count = scan ? m : joints + stale.size();

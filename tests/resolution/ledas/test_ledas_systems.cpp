@@ -31,6 +31,20 @@ Outcome run(std::vector<RigidBody> bodies, const LedasSettings& settings) {
 
 double normal_velocity_of(const Outcome& o, const Contact& c) { return normal_velocity(c, o.bodies[c.a], o.bodies[c.b]); }
 
+// The paper's pyramid drop with K rows.
+std::vector<RigidBody> pyramid_of(int rows) {
+  PyramidParams params;
+  params.rows = rows;
+  return make_pyramid(params);
+}
+
+// Complementary mode started with every touching contact, so that the search meets the redundant rows.
+LedasSettings touching_start() {
+  LedasSettings s = settings_for(LedasMode::complementary);
+  s.start_set = LedasStartSet::touching;
+  return s;
+}
+
 // Two solutions of the same impact: both exact (no cap reached, residual and complementarity error
 // ≤ 1e-9) and with the same velocities (1e-9 m/s: the velocities after an impact are unique).
 void expect_same_exact_answer(const Outcome& a, const Outcome& b) {
@@ -183,12 +197,8 @@ TEST(LedasSystems, BoxOnFivePointsSharesEqually) {
 // impulses and velocities (1e-9) — the proximal iteration's split among redundant contacts stays at the
 // minimum-norm one; resolving the same contact graph again reuses every symbolic analysis.
 TEST(LedasSystems, SparseAndDensePathsAgree) {
-  PyramidParams params;
-  params.rows = 20;
-  const std::vector<RigidBody> pyramid = make_pyramid(params);
-  LedasSettings sparse = settings_for(LedasMode::complementary);
-  sparse.start_set = LedasStartSet::touching;
-  LedasSettings dense = sparse;
+  const std::vector<RigidBody> pyramid = pyramid_of(20);
+  LedasSettings sparse = touching_start(), dense = sparse;
   sparse.solver.dense_limit = 8;
   dense.solver.dense_limit = 100000;
   const Outcome a = run(pyramid, sparse), b = run(pyramid, dense);
@@ -221,12 +231,8 @@ TEST(LedasSystems, SparseAndDensePathsAgree) {
 // search finds that set in at most 4 factorizations (2 here; 8 iterations and 4 factorizations without
 // it).
 TEST(LedasSystems, SearchShiftKeepsTheAnswer) {
-  PyramidParams params;
-  params.rows = 20;
-  const std::vector<RigidBody> pyramid = make_pyramid(params);
-  LedasSettings searched = settings_for(LedasMode::complementary);
-  searched.start_set = LedasStartSet::touching;
-  LedasSettings plain = searched;
+  const std::vector<RigidBody> pyramid = pyramid_of(20);
+  LedasSettings searched = touching_start(), plain = searched;
   plain.solver.search_regularization = 0.0;
   const Outcome a = run(pyramid, searched), b = run(pyramid, plain);
   EXPECT_EQ(a.counters.non_converged, 0u);
@@ -251,12 +257,8 @@ TEST(LedasSystems, SearchShiftKeepsTheAnswer) {
 // with and without that switch they agree to 1e-9 m/s; both are exact (residual and complementarity
 // error ≤ 1e-9), and the sharpened run takes fewer steps.
 TEST(LedasSystems, SharpenedRefinementKeepsTheAnswerInFewerSteps) {
-  PyramidParams params;
-  params.rows = 50;
-  const std::vector<RigidBody> pyramid = make_pyramid(params);
-  LedasSettings sharpened = settings_for(LedasMode::complementary);
-  sharpened.start_set = LedasStartSet::touching;
-  LedasSettings plain = sharpened;
+  const std::vector<RigidBody> pyramid = pyramid_of(50);
+  LedasSettings sharpened = touching_start(), plain = sharpened;
   plain.solver.sharpen_refinement = false;
   const Outcome a = run(pyramid, sharpened), b = run(pyramid, plain);
   expect_same_exact_answer(a, b);
@@ -275,12 +277,8 @@ TEST(LedasSystems, SharpenedRefinementKeepsTheAnswerInFewerSteps) {
 // error ≤ 1e-9).
 TEST(LedasSystems, ImpactStartSetKeepsThePyramidsAnswer) {
   for (int rows : {20, 50}) {
-    PyramidParams params;
-    params.rows = rows;
-    const std::vector<RigidBody> pyramid = make_pyramid(params);
-    LedasSettings impact = settings_for(LedasMode::complementary), touching = impact;
-    touching.start_set = LedasStartSet::touching;
-    const Outcome a = run(pyramid, impact), b = run(pyramid, touching);
+    const std::vector<RigidBody> pyramid = pyramid_of(rows);
+    const Outcome a = run(pyramid, settings_for(LedasMode::complementary)), b = run(pyramid, touching_start());
     expect_same_exact_answer(a, b);
     EXPECT_EQ(a.stats.velocity.sparse, 1u);
     EXPECT_EQ(a.stats.velocity.released, 0u);
