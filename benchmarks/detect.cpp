@@ -2,8 +2,8 @@
 // on towers of resting boxes, with the broadphase / narrowphase split measured inside the detector
 // (FclDetector::last_profile(), steady clock). Every iteration nudges the movable bodies by ±1 nm so
 // the broadphase refreshes every box and updates its tree as in a real step; contacts are unchanged.
-#include "fcl/fcl_detector.hpp"
-#include "impetus/core/generators.hpp"
+#include "impetus/detection/fcl/fcl_detector.hpp"
+#include "impetus/engine/generators.hpp"
 
 #include <benchmark/benchmark.h>
 

@@ -1,4 +1,4 @@
-// "Model no more than a scene needs" (shared/DESIGN.md), measured: each lever of the engine switched on
+// "Model no more than a scene needs" (docs/architecture.md), measured: each lever of the engine switched on
 // and off on the same scene, one whole step (detect + resolve + integrate) per iteration from the same
 // state (restored untimed before each step). Rows: model/<lever>/<on|off>. Counters: bodies,
 // contacts, rows_solved (contacts that entered a system), islands, and the per-stage times.
@@ -20,8 +20,8 @@
 //                 touching contact (off, `start_set: touching`): the same answer, another first guess.
 #include "support/bench_steps.hpp"
 
-#include "impetus/core/scene.hpp"
-#include "impetus/core/world.hpp"
+#include "impetus/engine/scene.hpp"
+#include "impetus/engine/world.hpp"
 #include "impetus/plugins/host.hpp"
 
 #include <benchmark/benchmark.h>

@@ -10,8 +10,8 @@
 #include "support/bench_scenes.hpp"
 #include "support/bench_steps.hpp"
 
-#include "impetus/core/world.hpp"
-#include "momentum/momentum.hpp"
+#include "impetus/engine/world.hpp"
+#include "impetus/integrators/momentum/momentum.hpp"
 
 #include <benchmark/benchmark.h>
 

@@ -43,10 +43,11 @@ endfunction()
 # impetus_add_module_library(<target> SOURCES <files...> [INCLUDE_DIR <dir>] [PUBLIC_LIBRARIES <...>]
 #                            [PRIVATE_LIBRARIES <...>])
 #
-# The plain library behind a plugin (STYLE.md: "the algorithm as a plain library that tests can call
+# The plain library behind a plugin ("the algorithm as a plain library that tests can call
 # directly, plus a thin entry file"): STATIC, position-independent so it can go into the plugin's shared
 # object, hidden visibility, built against Impetus::plugin_api (never the core library). INCLUDE_DIR
-# (the folder above the plugin's own, so headers read "euler/euler.hpp") is exported to its users.
+# (the plugin's include root, so headers read "impetus/integrators/euler/euler.hpp") is exported to its
+# users.
 function(impetus_add_module_library target)
   cmake_parse_arguments(ARG "" "INCLUDE_DIR" "SOURCES;PUBLIC_LIBRARIES;PRIVATE_LIBRARIES" ${ARGN})
   add_library(${target} STATIC ${ARG_SOURCES})

@@ -4,8 +4,8 @@
 
 #include "impetus/assets/mesh_body.hpp"
 #include "impetus/core/error.hpp"
-#include "impetus/core/scene.hpp"
-#include "impetus/core/world.hpp"
+#include "impetus/engine/scene.hpp"
+#include "impetus/engine/world.hpp"
 
 #include <unistd.h>
 

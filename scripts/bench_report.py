@@ -17,7 +17,7 @@ import re
 import subprocess
 import sys
 
-# The paper's table (sec. 5; shared/DESIGN.md, "Benchmark scenes"): name, bodies, contacts, seconds,
+# The paper's table (sec. 5; docs/conventions.md, "Benchmark scenes"): name, bodies, contacts, seconds,
 # and the Impetus scene that reproduces it.
 PAPER = [
     ("Line", 10, 10, 0.00085, "line_10_e0"),
@@ -350,7 +350,7 @@ def main():
         out += ["## Detection alone (`detect` family)", "", detect_table(detect["rows"]), ""]
     if model:
         out += ["## Model no more than a scene needs (`model` family)", "",
-                "Each lever of shared/DESIGN.md switched on and off on the same scene; one whole step from the "
+                "Each lever of "model no more than a scene needs" (docs/architecture.md) switched on and off on the same scene; one whole step from the "
                 "same state per iteration (`benchmarks/model.cpp`).", "", model_table(model["rows"]), ""]
     if peers:
         out += ["## Peers side by side (`peers` benchmark)", "",

@@ -23,7 +23,7 @@ if [ "${IMPETUS_SANITIZE_TESTS:-1}" != "0" ]; then
   built=$(date +%s)
   # A report of either sanitizer stops the process with a non-zero status, so the test fails. The
   # embedding example is left out: it is an outside project built without the sanitizer, which cannot
-  # load a sanitized libimpetus_core.so ("ASan runtime does not come first").
+  # load a sanitized libimpetus_engine.so ("ASan runtime does not come first").
   ASAN_OPTIONS=halt_on_error=1:detect_leaks=1:check_initialization_order=1 \
   UBSAN_OPTIONS=halt_on_error=1:print_stacktrace=1 LSAN_OPTIONS=suppressions=$root/fuzz/lsan.supp \
     ctest --test-dir "$asan" --output-on-failure -j "$(nproc)" -E "^example_embed_installed$" "$@"

@@ -6,9 +6,9 @@
 
 #include "assimp_reader.hpp"
 #include "impetus/core/error.hpp"
-#include "impetus/plugins/host.hpp"
 #include "text.hpp"
 
+#include <dlfcn.h>
 #include <fcntl.h>
 #include <poll.h>
 #include <spawn.h>
@@ -30,9 +30,6 @@
 
 extern char** environ;  // POSIX leaves the declaration to the program
 
-#ifndef IMPETUS_PLUGIN_SUBDIR
-#error "IMPETUS_PLUGIN_SUBDIR must be defined by the build (see core/CMakeLists.txt)"
-#endif
 #ifndef IMPETUS_MESH_IMPORTER_SUBPATH
 #error "IMPETUS_MESH_IMPORTER_SUBPATH must be defined by the build (see assets/CMakeLists.txt)"
 #endif
@@ -68,13 +65,18 @@ std::optional<double> positive_number(const fs::path& file, const char* variable
   return value;
 }
 
-// `<directory of libimpetus_core.so>/impetus/libexec/impetus-mesh-import`: found the way the plugin
-// host finds its plugins, so it works in the build tree and in an installed, relocated prefix alike.
+// Its address locates libimpetus_assets.so for dladdr.
+const char kLocator = 0;
+
+// `<directory of libimpetus_assets.so>/impetus/libexec/impetus-mesh-import`: relative to this library, as
+// the plugin host finds its plugins relative to its own, so it works in the build tree and in an
+// installed, relocated prefix alike (canonical, so a symlinked library still finds the real folder).
 fs::path default_importer() {
-  fs::path library_dir = PluginHost::default_directory();  // <library dir>/IMPETUS_PLUGIN_SUBDIR
-  if (library_dir.empty()) return {};
-  for ([[maybe_unused]] const fs::path& step : fs::path(IMPETUS_PLUGIN_SUBDIR)) library_dir = library_dir.parent_path();
-  return library_dir / IMPETUS_MESH_IMPORTER_SUBPATH;
+  Dl_info info{};
+  if (dladdr(&kLocator, &info) == 0 || info.dli_fname == nullptr || info.dli_fname[0] == '\0') return {};
+  std::error_code ec;
+  const fs::path library = fs::canonical(info.dli_fname, ec);
+  return (ec ? fs::absolute(info.dli_fname) : library).parent_path() / IMPETUS_MESH_IMPORTER_SUBPATH;
 }
 
 // --- descriptors and the process, each released on every path -----------------------------------
@@ -361,7 +363,7 @@ IsolationSettings isolation_settings(const fs::path& file, std::uintmax_t file_s
     settings.importer_origin = "set by IMPETUS_MESH_IMPORT_HELPER";
   } else {
     settings.importer = default_importer();
-    settings.importer_origin = "looked for next to libimpetus_core.so, in " + settings.importer.parent_path().string();
+    settings.importer_origin = "looked for next to libimpetus_assets.so, in " + settings.importer.parent_path().string();
   }
   settings.limits.memory_bytes = kBaseMemoryBytes + kMemoryPerFileByte * file_size;
   if (const auto mib = positive_number(file, "IMPETUS_MESH_IMPORT_MEMORY_MB", "MiB"))

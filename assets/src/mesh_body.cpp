@@ -25,7 +25,7 @@ MeshBody make_mesh_body(const TriangleMesh& mesh, const std::string& label) {
                 " are not those of any solid: the mesh probably intersects itself");
   }
   body.center_of_mass_file = body.unit.center_of_mass;
-  // The body frame of shared/DESIGN.md: origin at the center of mass, axes as in the file (so a body
+  // The body frame of docs/conventions.md: origin at the center of mass, axes as in the file (so a body
   // with the identity orientation looks as modelled; the inertia is then a full tensor).
   auto centered = std::make_shared<TriangleMesh>(mesh);
   for (Vec3& v : centered->vertices) v -= body.center_of_mass_file;

@@ -6,8 +6,8 @@
 /// tests (tests/accuracy/, coarse settings, asserting each scenario's criterion for the methods
 /// expected to pass it).
 
-#include "impetus/core/scene.hpp"
-#include "impetus/core/world.hpp"
+#include "impetus/engine/scene.hpp"
+#include "impetus/engine/world.hpp"
 
 #include <chrono>
 #include <cstddef>

@@ -6,7 +6,7 @@ set(_accuracy_dir "${CMAKE_CURRENT_LIST_DIR}")
 add_library(impetus_accuracy STATIC
   ${_accuracy_dir}/scenarios.cpp ${_accuracy_dir}/probes.cpp ${_accuracy_dir}/runner.cpp ${_accuracy_dir}/report.cpp)
 target_include_directories(impetus_accuracy PUBLIC ${_accuracy_dir})
-target_link_libraries(impetus_accuracy PUBLIC impetus_core nlohmann_json::nlohmann_json
+target_link_libraries(impetus_accuracy PUBLIC impetus_engine nlohmann_json::nlohmann_json
                                        PRIVATE impetus_compile_options)
 # Runs load these plugins by name at run time.
 set(IMPETUS_ACCURACY_PLUGINS impetus_integrator_euler impetus_integrator_momentum impetus_integrator_splitting

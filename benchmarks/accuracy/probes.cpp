@@ -1,7 +1,7 @@
 // Error measures of the accuracy scenarios (probes.hpp says what each one means).
 #include "probes.hpp"
 
-#include "impetus/core/metrics.hpp"
+#include "impetus/engine/metrics.hpp"
 
 #include <Eigen/Dense>
 

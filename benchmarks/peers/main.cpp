@@ -1,4 +1,4 @@
-// bench_peers: the paper's benchmark scenes (DESIGN.md, "Benchmark scenes") stepped once by Bullet, ODE
+// bench_peers: the paper's benchmark scenes (docs/conventions.md, "Benchmark scenes") stepped once by Bullet, ODE
 // and MuJoCo, side by side with Impetus's resolvers, judged by the same velocity-based counters as
 // benchmarks/resolve.cpp. What each row measures and the settings are in README.md.
 //

@@ -1,12 +1,12 @@
 #pragma once
 /// \file
-/// The benchmark scenes of shared/DESIGN.md ("Benchmark scenes") prepared once for every family and for
+/// The benchmark scenes of docs/conventions.md ("Benchmark scenes") prepared once for every family and for
 /// the peers: bodies in their initial state and the contacts the `fcl` detector finds there. Resolver
 /// benchmarks restore `bodies` before every iteration and hand the same contact list to each resolver,
 /// so every method (and every peer engine) starts from the identical state.
 
-#include "fcl/fcl_detector.hpp"
-#include "impetus/core/generators.hpp"
+#include "impetus/detection/fcl/fcl_detector.hpp"
+#include "impetus/engine/generators.hpp"
 #include "common/impulse_rows.hpp"
 
 #include <algorithm>

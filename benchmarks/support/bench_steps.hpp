@@ -7,7 +7,7 @@
 
 #include "support/bench_scenes.hpp"
 
-#include "impetus/core/world.hpp"
+#include "impetus/engine/world.hpp"
 
 #include <benchmark/benchmark.h>
 

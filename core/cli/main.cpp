@@ -1,11 +1,11 @@
 // The `impetus` command-line tool: run a scene, resolve one impact, list plugins, mass properties of a mesh.
-// Contract: shared/DESIGN.md, "Command-line contract"; README.md documents every option.
+// Contract: README.md, "The `impetus` tool", documents every option.
 
 #include "mass_command.hpp"
 #include "report.hpp"
 
 #include "impetus/core/error.hpp"
-#include "impetus/core/scene.hpp"
+#include "impetus/engine/scene.hpp"
 #include "impetus/plugins/host.hpp"
 
 #include <CLI/CLI.hpp>

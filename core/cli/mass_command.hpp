@@ -1,6 +1,6 @@
 #pragma once
 // `impetus mass MESH [--density D | --mass M] [--scale S] [--part NAME] [--json]`: the mass properties
-// of a mesh file (shared/DESIGN.md, "Command-line contract"), computed exactly as a scene would.
+// of a mesh file (README.md, "The `impetus` tool"), computed exactly as a scene would.
 
 #include <CLI/CLI.hpp>
 

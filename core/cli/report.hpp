@@ -2,8 +2,8 @@
 // Summaries and output files of the `impetus` tool: run statistics, the trajectory CSV, and the JSON
 // documents of `run --json`, `resolve --json` and `plugins --json`.
 
-#include "impetus/core/metrics.hpp"
-#include "impetus/core/world.hpp"
+#include "impetus/engine/metrics.hpp"
+#include "impetus/engine/world.hpp"
 #include "impetus/plugins/host.hpp"
 
 #include <nlohmann/json.hpp>
@@ -55,7 +55,7 @@ class TrajectoryWriter {
   std::ofstream out_;
 };
 
-/// The `resolve --json` document (shared/DESIGN.md, "Command-line contract").
+/// The `resolve --json` document (README.md, "The `impetus` tool").
 nlohmann::json resolve_report(const World& world, const std::string& resolver, double seconds);
 
 /// The `plugins --json` document.

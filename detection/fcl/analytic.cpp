@@ -1,4 +1,4 @@
-#include "analytic.hpp"
+#include "impetus/detection/fcl/analytic.hpp"
 
 #include <algorithm>
 #include <cmath>

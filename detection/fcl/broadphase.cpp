@@ -1,4 +1,4 @@
-#include "broadphase.hpp"
+#include "impetus/detection/fcl/broadphase.hpp"
 
 #include "fcl_shape.hpp"
 

@@ -1,11 +1,11 @@
-#include "fcl_detector.hpp"
+#include "impetus/detection/fcl/fcl_detector.hpp"
 
-#include "analytic.hpp"
-#include "broadphase.hpp"
-#include "fcl_queries.hpp"
-#include "manifold.hpp"
-#include "mesh_contacts.hpp"
-#include "shapes.hpp"
+#include "impetus/detection/fcl/analytic.hpp"
+#include "impetus/detection/fcl/broadphase.hpp"
+#include "impetus/detection/fcl/fcl_queries.hpp"
+#include "impetus/detection/fcl/manifold.hpp"
+#include "impetus/detection/fcl/mesh_contacts.hpp"
+#include "impetus/detection/fcl/shapes.hpp"
 
 #include <algorithm>
 #include <chrono>

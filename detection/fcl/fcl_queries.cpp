@@ -1,4 +1,4 @@
-#include "fcl_queries.hpp"
+#include "impetus/detection/fcl/fcl_queries.hpp"
 
 #include "fcl_shape.hpp"
 

@@ -1,5 +1,5 @@
 // Supporting features and candidate axes of the shapes (declared in shapes.hpp).
-#include "shapes.hpp"
+#include "impetus/detection/fcl/shapes.hpp"
 
 #include <algorithm>
 #include <cmath>

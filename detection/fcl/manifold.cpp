@@ -1,4 +1,4 @@
-#include "manifold.hpp"
+#include "impetus/detection/fcl/manifold.hpp"
 
 #include <algorithm>
 #include <array>

@@ -1,4 +1,4 @@
-#include "mesh_contacts.hpp"
+#include "impetus/detection/fcl/mesh_contacts.hpp"
 
 #include <algorithm>
 #include <cmath>

@@ -1,5 +1,5 @@
 // Plugin entry for the default detector; the algorithm is in fcl_detector.cpp and its helpers.
-#include "fcl/fcl_detector.hpp"
+#include "impetus/detection/fcl/fcl_detector.hpp"
 #include "impetus/plugins/export.hpp"
 
 IMPETUS_PLUGIN(impetus::CollisionDetector, impetus::FclDetector, "fcl", "1.0.0",

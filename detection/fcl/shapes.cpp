@@ -1,4 +1,4 @@
-#include "shapes.hpp"
+#include "impetus/detection/fcl/shapes.hpp"
 
 #include <algorithm>
 #include <cmath>

@@ -5,9 +5,9 @@
 //                     known first-order error) to 1e-9
 #include <impetus/core/error.hpp>
 #include <impetus/core/mass.hpp>
-#include <impetus/core/metrics.hpp>
-#include <impetus/core/scene.hpp>
-#include <impetus/core/world.hpp>
+#include <impetus/engine/metrics.hpp>
+#include <impetus/engine/scene.hpp>
+#include <impetus/engine/world.hpp>
 #include <impetus/plugins/host.hpp>
 
 #include <cmath>
@@ -15,7 +15,7 @@
 
 int main(int argc, char** argv) {
   try {
-    impetus::PluginHost host;  // finds the plugins installed next to libimpetus_core.so
+    impetus::PluginHost host;  // finds the plugins installed next to libimpetus_plugin_host.so
 
     // A world made in code: one 2 kg ball dropped from rest.
     impetus::WorldSettings settings;
@@ -35,7 +35,7 @@ int main(int argc, char** argv) {
 
     const int steps = 1000;
     for (int i = 0; i < steps; ++i) world.step();
-    // Velocities first, then positions (DESIGN.md, "The step"): z_n = z0 − ½ g t² − ½ g dt t exactly.
+    // Velocities first, then positions (docs/conventions.md, "The step"): z_n = z0 − ½ g t² − ½ g dt t exactly.
     const double t = world.time(), g = 9.81;
     const double expected = 100.0 - 0.5 * g * t * t - 0.5 * g * settings.dt * t;
     const double z = world.bodies()[0].position.z();

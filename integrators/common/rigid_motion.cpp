@@ -1,4 +1,4 @@
-#include "common/rigid_motion.hpp"
+#include "impetus/integrators/common/rigid_motion.hpp"
 
 namespace impetus::integrators {
 

@@ -1,4 +1,4 @@
-#include "euler/euler.hpp"
+#include "impetus/integrators/euler/euler.hpp"
 
 namespace impetus {
 

@@ -1,5 +1,5 @@
 // Plugin entry for the paper's integrator; the algorithm is in euler.cpp.
-#include "euler/euler.hpp"
+#include "impetus/integrators/euler/euler.hpp"
 #include "impetus/plugins/export.hpp"
 
 IMPETUS_PLUGIN(impetus::Integrator, impetus::EulerIntegrator, "euler", "1.0.0",

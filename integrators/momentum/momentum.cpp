@@ -1,4 +1,4 @@
-#include "momentum/momentum.hpp"
+#include "impetus/integrators/momentum/momentum.hpp"
 
 namespace impetus {
 

@@ -1,6 +1,6 @@
 // Plugin entry for the splitting integrator; the algorithm is in splitting.cpp.
 #include "impetus/plugins/export.hpp"
-#include "splitting/splitting.hpp"
+#include "impetus/integrators/splitting/splitting.hpp"
 
 IMPETUS_PLUGIN(impetus::Integrator, impetus::SplittingIntegrator, "splitting", "1.0.0",
                "eq. 2 translation, symmetric splitting of the free rotation: conserves L, "

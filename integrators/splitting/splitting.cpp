@@ -1,4 +1,4 @@
-#include "splitting/splitting.hpp"
+#include "impetus/integrators/splitting/splitting.hpp"
 
 #include <Eigen/Eigenvalues>
 

@@ -2,7 +2,7 @@
 /// \file
 /// Resting contact, shared by every impulse resolver (issue: resolvers, item 3).
 ///
-/// With the default split step (velocities → detect → resolve → positions; shared/DESIGN.md, "The
+/// With the default split step (velocities → detect → resolve → positions; docs/conventions.md, "The
 /// step") a resting body does not sink: the resolver removes the approach that gravity added before
 /// positions move. What remains is penetration that is already there (initial overlap, rounding,
 /// rotation of corners, the paper's step order). It is removed by a **position correction** that adds no

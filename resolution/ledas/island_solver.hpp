@@ -5,7 +5,7 @@
 /// A = G M⁻¹ Gᵀ) and a right-hand side come in, impulses come out, so it is tested directly.
 ///
 /// Equalities on a subset (the paper mode's rounds): the subset splits into independent blocks (rows
-/// coupled through a shared movable body), each solved by the cheapest exact method (shared/DESIGN.md,
+/// coupled through a shared movable body), each solved by the cheapest exact method (docs/architecture.md,
 /// "Model no more than a scene needs"):
 ///  - one row: closed form p = c / A_11;
 ///  - up to `dense_limit` rows: dense LDLᵀ with diagonal pivoting (rank-revealing for a PSD matrix);

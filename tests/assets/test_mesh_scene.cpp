@@ -6,8 +6,8 @@
 
 #include "impetus/assets/mesh_body.hpp"
 #include "impetus/core/error.hpp"
-#include "impetus/core/metrics.hpp"
-#include "impetus/core/scene.hpp"
+#include "impetus/engine/metrics.hpp"
+#include "impetus/engine/scene.hpp"
 #include "impetus/plugins/host.hpp"
 
 #include <cstdio>

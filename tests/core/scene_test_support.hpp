@@ -3,7 +3,7 @@
 // capture the Error a bad scene raises.
 
 #include "impetus/core/error.hpp"
-#include "impetus/core/scene.hpp"
+#include "impetus/engine/scene.hpp"
 
 #include <gtest/gtest.h>
 

@@ -1,5 +1,5 @@
 // build_world: a loaded scene becomes a World with its bodies, constraints and plugins. Uses the euler
-// integrator plugin from the build tree (found next to libimpetus_core.so) and no detector/resolver.
+// integrator plugin from the build tree (found next to libimpetus_plugin_host.so) and no detector/resolver.
 #include "impetus/plugins/host.hpp"
 #include "scene_test_support.hpp"
 

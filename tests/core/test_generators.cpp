@@ -1,6 +1,6 @@
-// The benchmark generators (shared/DESIGN.md, "Benchmark scenes"): body counts and contact counts of
+// The benchmark generators (docs/conventions.md, "Benchmark scenes"): body counts and contact counts of
 // the paper's table, and the exact geometry of every contact.
-#include "impetus/core/generators.hpp"
+#include "impetus/engine/generators.hpp"
 
 #include "scene_test_support.hpp"
 

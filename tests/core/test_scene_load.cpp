@@ -19,7 +19,7 @@ const RigidBody& body_named(const Scene& scene, const std::string& name) {
   return scene.bodies.front();
 }
 
-// shared/DESIGN.md's minimal example, without the mesh body (no asset pipeline yet) and with the
+// a minimal example in the spirit of README.md's, without the mesh body (no asset pipeline yet) and with the
 // constraint joining two bodies the example actually has.
 constexpr const char* kDesignExample = R"(dt: 0.001
 gravity: [0, 0, -9.81]

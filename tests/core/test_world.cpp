@@ -2,8 +2,8 @@
 // Modules here are tiny test doubles written against the module contracts, not plugins.
 #include "impetus/core/error.hpp"
 #include "impetus/core/mass.hpp"
-#include "impetus/core/metrics.hpp"
-#include "impetus/core/world.hpp"
+#include "impetus/engine/metrics.hpp"
+#include "impetus/engine/world.hpp"
 #include "impetus_test/bodies.hpp"
 
 #include <gtest/gtest.h>
@@ -121,7 +121,7 @@ TEST(WorldStep, PaperOrderIsVelocitiesPositionsDetectResolve) {
   EXPECT_EQ(log, (Log{"velocities", "positions", "detect", "resolve"}));
 }
 
-// DESIGN.md, "The step": in the paper's order a resting body sinks by g·dt² every step (positions move
+// docs/conventions.md, "The step": in the paper's order a resting body sinks by g·dt² every step (positions move
 // with velocities the resolver has not seen); in the split order it does not move. Tolerance 1e-12 m.
 TEST(WorldStep, RestingBallSinksByGDtSquaredPerStepOnlyInThePaperOrder) {
   const int steps = 100;

@@ -1,7 +1,7 @@
 #pragma once
 // Helpers shared by the detector tests: bodies of each shape, a cube / octahedron mesh, one-call
 // detection.
-#include "fcl/fcl_detector.hpp"
+#include "impetus/detection/fcl/fcl_detector.hpp"
 
 #include <gtest/gtest.h>
 

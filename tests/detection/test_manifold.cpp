@@ -1,8 +1,8 @@
 // The FCL-free manifold pieces of the `fcl` detector: clipping, segment closest points, supporting
 // features, duplicate merging and reduction to the largest-area 4 points. Each test states the geometric
 // fact it checks and its tolerance.
-#include "fcl/manifold.hpp"
-#include "fcl/shapes.hpp"
+#include "impetus/detection/fcl/manifold.hpp"
+#include "impetus/detection/fcl/shapes.hpp"
 
 #include <gtest/gtest.h>
 

@@ -2,7 +2,7 @@
 // b ((x_b − x_a)·n > 0, and equals the known direction), and the depth equals a known overlap.
 #include "detection_test_support.hpp"
 
-#include "fcl/analytic.hpp"
+#include "impetus/detection/fcl/analytic.hpp"
 
 #include <functional>
 #include <numbers>

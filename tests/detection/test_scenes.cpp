@@ -3,8 +3,8 @@
 // loads and runs from a scene file.
 #include "detection_test_support.hpp"
 
-#include "impetus/core/generators.hpp"
-#include "impetus/core/scene.hpp"
+#include "impetus/engine/generators.hpp"
+#include "impetus/engine/scene.hpp"
 #include "impetus/plugins/host.hpp"
 
 #include <cstring>

@@ -1,8 +1,8 @@
 // Physics checks of the three eq. 2 integrators, called as plain classes (no plugin loading). Each test
 // states the law it checks and its tolerance.
-#include "euler/euler.hpp"
-#include "momentum/momentum.hpp"
-#include "splitting/splitting.hpp"
+#include "impetus/integrators/euler/euler.hpp"
+#include "impetus/integrators/momentum/momentum.hpp"
+#include "impetus/integrators/splitting/splitting.hpp"
 
 #include <gtest/gtest.h>
 

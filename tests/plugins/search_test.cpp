@@ -1,5 +1,5 @@
 // Where the host looks: prepended (scene) directories, then IMPETUS_PLUGIN_PATH, then the directory next
-// to libimpetus_core.so; and what it says when a name is found nowhere.
+// to libimpetus_plugin_host.so; and what it says when a name is found nowhere.
 #include "plugin_test_support.hpp"
 
 namespace {

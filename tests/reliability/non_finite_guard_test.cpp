@@ -3,7 +3,7 @@
 // state. The step reports the body, the stage and the step; every body keeps its last finite state, bit
 // for bit; time does not advance; and a world that keeps producing it stays stopped there.
 
-#include "impetus/core/metrics.hpp"
+#include "impetus/engine/metrics.hpp"
 #include "reliability_support.hpp"
 
 #include <limits>

@@ -3,8 +3,8 @@
 // scene text with the shipped plugins (and the test fixtures, for the fault injectors).
 
 #include "impetus/core/error.hpp"
-#include "impetus/core/scene.hpp"
-#include "impetus/core/world.hpp"
+#include "impetus/engine/scene.hpp"
+#include "impetus/engine/world.hpp"
 #include "impetus/plugins/host.hpp"
 
 #include <gtest/gtest.h>
@@ -68,7 +68,7 @@ inline std::string error_of(const std::function<void()>& fn) {
   return "<no error>";
 }
 
-/// A plugin host that sees the shipped plugins (next to libimpetus_core.so) and then the fixtures.
+/// A plugin host that sees the shipped plugins (next to libimpetus_plugin_host.so) and then the fixtures.
 inline std::unique_ptr<PluginHost> make_host() {
   auto host = std::make_unique<PluginHost>();
   host->prepend_directories({IMPETUS_PLUGIN_DIR, IMPETUS_FIXTURE_DIR});

@@ -12,8 +12,8 @@
 // at the end exceeds the first checkpoint after 10 % of the run by more than 1 MiB.
 
 #include "impetus/core/error.hpp"
-#include "impetus/core/metrics.hpp"
-#include "impetus/core/scene.hpp"
+#include "impetus/engine/metrics.hpp"
+#include "impetus/engine/scene.hpp"
 #include "impetus/plugins/host.hpp"
 
 #include <sys/resource.h>

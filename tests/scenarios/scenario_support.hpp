@@ -1,8 +1,8 @@
 #pragma once
 // Loading a bundled scene (assets/scenes/) into a World through the real plugins, and skipping a test
 // whose plugins are not built yet.
-#include "impetus/core/metrics.hpp"
-#include "impetus/core/scene.hpp"
+#include "impetus/engine/metrics.hpp"
+#include "impetus/engine/scene.hpp"
 #include "impetus/plugins/host.hpp"
 
 #include <gtest/gtest.h>

@@ -5,7 +5,7 @@
 /// initial state is identical), stepped by the engine, and its bodies' state written back onto the
 /// Impetus bodies so that the suite's own probes judge it (README.md in the parent folder).
 
-#include "impetus/core/world.hpp"
+#include "impetus/engine/world.hpp"
 
 #include <cstddef>
 #include <functional>

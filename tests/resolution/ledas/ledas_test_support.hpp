@@ -2,7 +2,7 @@
 // Hand-built bodies, contacts and tiny analytic detectors for the LEDAS resolver tests (no FCL).
 #include "impetus_test/bodies.hpp"
 #include "impetus/core/mass.hpp"
-#include "impetus/core/metrics.hpp"
+#include "impetus/engine/metrics.hpp"
 #include "impetus/modules/contact.hpp"
 #include "impetus/modules/detector.hpp"
 #include "ledas/ledas.hpp"

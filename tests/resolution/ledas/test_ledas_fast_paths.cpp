@@ -1,7 +1,7 @@
 // The fast paths of the LEDAS resolver checked against straightforward references: the masked sparse
 // LDLᵀ against dense algebra, the proximal complementarity solve on rank-deficient start sets, and the
 // paper mode's cheap rounds against the rounds written out literally (sec. 3.2).
-#include "impetus/core/generators.hpp"
+#include "impetus/engine/generators.hpp"
 #include "ledas/island_solver.hpp"
 #include "ledas/masked_ldlt.hpp"
 #include "ledas_test_support.hpp"

@@ -1,6 +1,6 @@
 // LEDAS resolver on the paper's benchmark scenes (pyramid drop, line push) and singular systems
 // (Figure 2, a box on five points); the dense and sparse paths agree.
-#include "impetus/core/generators.hpp"
+#include "impetus/engine/generators.hpp"
 #include "ledas_test_support.hpp"
 
 #include <gtest/gtest.h>

@@ -1,8 +1,8 @@
 // LEDAS resolver inside a World (split step, the paper's euler integrator): assembly constraints at
 // velocity and position level (sec. 4), resting boxes and stacks, a ball landing through a gap
 // contact; options and constraint acceptance.
-#include "euler/euler.hpp"
-#include "impetus/core/world.hpp"
+#include "impetus/integrators/euler/euler.hpp"
+#include "impetus/engine/world.hpp"
 #include "ledas_test_support.hpp"
 
 #include <gtest/gtest.h>

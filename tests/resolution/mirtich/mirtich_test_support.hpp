@@ -4,7 +4,7 @@
 #include "impetus/core/body.hpp"
 #include "impetus_test/bodies.hpp"
 #include "impetus/core/mass.hpp"
-#include "impetus/core/metrics.hpp"
+#include "impetus/engine/metrics.hpp"
 #include "impetus/modules/contact.hpp"
 #include "mirtich/mirtich.hpp"
 

@@ -1,7 +1,7 @@
 // The sequential resolver on many contacts: conservation laws, the paper's benchmark scenes (pyramid,
 // line) with their impulse counts, stacks that make sequential resolution "almost freeze" (paper,
 // sec. 1), the cap, the position correction and the options.
-#include "impetus/core/generators.hpp"
+#include "impetus/engine/generators.hpp"
 #include "mirtich_test_support.hpp"
 
 #include <chrono>

@@ -1,7 +1,7 @@
 #pragma once
 /// \file
 /// A mesh made ready to be a rigid body: imported, validated, its frame moved to its center of mass
-/// (the body frame of shared/DESIGN.md), its convex hull built and its mass properties computed.
+/// (the body frame of docs/conventions.md), its convex hull built and its mass properties computed.
 /// The scene loader uses this for `shape: {mesh: …}`; `impetus mass` prints the same numbers.
 
 #include "impetus/assets/mass_properties.hpp"

@@ -15,7 +15,7 @@
 /// normals differ, and it merges within a tolerance rather than on equality).
 ///
 /// Isolation. assimp reads the file in a separate process, `impetus-mesh-import`, found next to
-/// libimpetus_core.so (`<libdir>/impetus/libexec/`, in the build tree and in an installed, relocated
+/// libimpetus_assets.so (`<libdir>/impetus/libexec/`, in the build tree and in an installed, relocated
 /// prefix alike). assimp 5.2 can crash, abort or allocate without bound on a malformed file; in that
 /// process this ends the import with an Error naming the file and what happened, never the program.
 /// The process imports under limits, and the library checks everything it sends back. Environment

@@ -2,7 +2,7 @@
 /// \file
 /// The rigid body: configuration (shape, mass properties, material) and state (pose, velocities).
 ///
-/// Conventions (shared/DESIGN.md): `position` is the world position of the center of mass; `rotation`
+/// Conventions (docs/conventions.md): `position` is the world position of the center of mass; `rotation`
 /// maps body to world coordinates (p_world = position + rotation · p_body); the body frame's origin is
 /// the center of mass. World inertia J_world = R J_body Rᵀ. Velocities are in the world frame.
 /// A fixed body has infinite mass and inertia: its inverse mass and inverse inertia are zero, so its

@@ -2,7 +2,7 @@
 /// \file
 /// Math types used throughout Impetus (Eigen, double precision) and small rotation helpers.
 /// Conventions: SI units, right-handed world frame; a rotation matrix R maps body coordinates to world
-/// coordinates (p_world = x + R p_body). See shared/DESIGN.md, "Conventions".
+/// coordinates (p_world = x + R p_body). See docs/conventions.md.
 
 #include <Eigen/Dense>
 

@@ -1,6 +1,6 @@
 #pragma once
 /// \file
-/// Collision shapes in the body frame, centered on the body's center of mass (shared/DESIGN.md,
+/// Collision shapes in the body frame, centered on the body's center of mass (docs/conventions.md,
 /// "Scene files"). Shapes carry geometry only; mass properties live in RigidBody.
 
 #include "impetus/core/math.hpp"

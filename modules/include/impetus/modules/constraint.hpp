@@ -12,7 +12,7 @@ namespace impetus {
 /// How a constraint is enforced (paper, sec. 4).
 enum class ConstraintLevel : std::uint8_t {
   velocity,  ///< the joined points' relative velocity is zeroed each step (drifts apart slowly)
-  position   ///< the impulse makes the points coincide after the step (eq. 10, as DESIGN.md reads it)
+  position   ///< the impulse makes the points coincide after the step (eq. 10, as docs/conventions.md reads it)
 };
 
 /// "Point-point": a point of body a and a point of body b stay together (a ball joint).

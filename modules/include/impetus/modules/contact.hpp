@@ -2,7 +2,7 @@
 /// \file
 /// Contacts: what a collision detector hands a collision resolver.
 ///
-/// Convention (shared/DESIGN.md): bodies `a` < `b` by index; world point `point`; unit `normal` pointing
+/// Convention (docs/conventions.md): bodies `a` < `b` by index; world point `point`; unit `normal` pointing
 /// **out of a into b**; `depth` ≥ 0 is penetration, a negative value a gap within the detector's margin.
 /// Relative normal velocity v_n = (u_b − u_a)·n, with u = v + ω × r; the contact approaches when v_n < 0.
 /// An impulse magnitude p ≥ 0 pushes the bodies apart: −p n on a, +p n on b.
@@ -35,7 +35,7 @@ inline double combined_restitution(const RigidBody& a, const RigidBody& b) {
   return std::max(a.material.restitution, b.material.restitution);
 }
 
-/// Applies impulse magnitude `p` at contact `c` with DESIGN.md's sign: −p n on a, +p n on b
+/// Applies impulse magnitude `p` at contact `c` with the sign of docs/conventions.md: −p n on a, +p n on b
 /// (Δv_a = −p n / M_a, Δω_a = −J_a⁻¹ (r_a × p n), and the opposite for b). Fixed bodies are untouched.
 inline void apply_contact_impulse(const Contact& c, double p, RigidBody& a, RigidBody& b) {
   const Vec3 impulse = p * c.normal;

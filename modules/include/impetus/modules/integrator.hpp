@@ -1,7 +1,7 @@
 #pragma once
 /// \file
 /// The integrator module contract. The world calls the two phases around detection and resolution
-/// (shared/DESIGN.md, "The step"): velocities first, positions last, so resolved velocities move bodies.
+/// (docs/conventions.md, "The step"): velocities first, positions last, so resolved velocities move bodies.
 
 #include "impetus/core/body.hpp"
 #include "impetus/modules/step.hpp"

@@ -1,0 +1,168 @@
+// Scene files: the top level of the format (README.md, "Scene files"), and building a World.
+// The parts live in scene_bodies.cpp, scene_modules.cpp, scene_entries.cpp and scene_override.cpp.
+
+#include "impetus/engine/scene.hpp"
+
+#include "impetus/plugins/host.hpp"
+#include "scene_internal.hpp"
+
+#include <cerrno>
+#include <cstring>
+#include <fstream>
+#include <sstream>
+
+namespace impetus {
+namespace {
+
+using scene_detail::Fields;
+using scene_detail::ReadBody;
+using scene_detail::SceneReader;
+
+// A generated fixed plane identical to a body the scene already has (the pyramid's "ground" in a scene
+// that has its own ground, as in the README's example) is the same body: it is kept once.
+bool same_fixed_plane(const RigidBody& a, const RigidBody& b) {
+  const auto* pa = std::get_if<Plane>(&a.shape);
+  const auto* pb = std::get_if<Plane>(&b.shape);
+  return a.fixed && b.fixed && pa && pb && pa->normal == pb->normal && pa->offset == pb->offset &&
+         a.position == b.position && a.rotation == b.rotation;
+}
+
+// Adds `read` to the scene, refusing a name already taken (names are how constraints, `--set` and
+// the CLI's output refer to bodies).
+void add_bodies(const SceneReader& r, std::vector<ReadBody> read, bool generated, Scene& scene,
+                std::map<std::string, BodyIndex>& index_by_name, std::map<std::string, std::string>& where_by_name) {
+  for (ReadBody& b : read) {
+    const auto [it, inserted] = index_by_name.emplace(b.body.name, static_cast<BodyIndex>(scene.bodies.size()));
+    if (!inserted && generated && same_fixed_plane(scene.bodies[it->second], b.body)) continue;
+    if (!inserted)
+      r.fail(b.where, "duplicate body name '" + b.body.name + "' (first at " + where_by_name[b.body.name] + ")");
+    where_by_name[b.body.name] = r.where(b.where);
+    scene.bodies.push_back(std::move(b.body));
+  }
+}
+
+Scene read_scene(const SceneReader& r, const YAML::Node& root) {
+  if (!root.IsMap()) r.fail(root, "a scene is a mapping of keys (dt, gravity, modules, bodies, ...), got " +
+                                      SceneReader::describe(root));
+  const Fields f(r, root, "scene",
+                 {"dt", "gravity", "step_order", "plugin_path", "modules", "bodies", "generators", "constraints"});
+  Scene scene;
+  if (const YAML::Node* n = f.find("dt")) scene.settings.dt = r.positive(*n, "dt");
+  if (const YAML::Node* n = f.find("gravity")) scene.settings.gravity = r.vec3(*n, "gravity");
+  if (const YAML::Node* n = f.find("step_order"))
+    scene.settings.order = r.choice(*n, "step_order", {"split", "paper"}) == "paper" ? StepOrder::paper
+                                                                                     : StepOrder::split;
+  if (const YAML::Node* n = f.find("plugin_path")) {
+    // One directory or a list of them, relative to the scene file.
+    const std::vector<YAML::Node> dirs = n->IsSequence() ? r.list(*n, "plugin_path") : std::vector{*n};
+    for (const YAML::Node& dir : dirs) {
+      const std::string text = r.string(dir, "plugin_path");
+      if (text.empty()) r.fail(dir, "'plugin_path' entries must not be empty");
+      scene.plugin_path.push_back(r.resolve_path(text));
+    }
+  }
+
+  const YAML::Node* modules = f.find("modules");
+  std::optional<Fields> m;
+  if (modules && !modules->IsNull()) m.emplace(r, *modules, "modules", std::initializer_list<std::string_view>{
+                                                                        "integrator", "detector", "resolver"});
+  const auto module_node = [&](const char* kind) { return m ? m->find(kind) : nullptr; };
+  scene.integrator = scene_detail::read_module(r, module_node("integrator"), ModuleKind::integrator);
+  scene.detector = scene_detail::read_module(r, module_node("detector"), ModuleKind::detector);
+  scene.resolver = scene_detail::read_module(r, module_node("resolver"), ModuleKind::resolver);
+
+  std::map<std::string, BodyIndex> index_by_name;
+  std::map<std::string, std::string> where_by_name;
+  if (const YAML::Node* n = f.find("bodies")) {
+    const std::vector<YAML::Node> list = r.list(*n, "bodies");
+    for (std::size_t i = 0; i < list.size(); ++i)
+      add_bodies(r, {scene_detail::read_body(r, list[i], i)}, false, scene, index_by_name, where_by_name);
+  }
+  if (const YAML::Node* n = f.find("generators"))
+    for (const YAML::Node& entry : r.list(*n, "generators"))
+      add_bodies(r, scene_detail::read_generator(r, entry), true, scene, index_by_name, where_by_name);
+  // Constraints last: they name bodies, including generated ones, and use their initial poses.
+  if (const YAML::Node* n = f.find("constraints"))
+    for (const YAML::Node& entry : r.list(*n, "constraints"))
+      scene.constraints.push_back(scene_detail::read_constraint(r, entry, scene.bodies, index_by_name));
+  return scene;
+}
+
+// A programmatic Scene may leave a module empty: it gets the scene file's default.
+PluginRequest plugin_request(const ModuleRequest& module, ModuleKind kind, const char* fallback,
+                             ModuleOptions& options) {
+  PluginRequest request;
+  request.kind = kind;
+  request.name = module.plugin.empty() ? fallback : module.plugin;
+  request.file = module.path;
+  request.options = &options;
+  request.where = module.where;
+  return request;
+}
+
+}  // namespace
+
+Scene load_scene_text(const std::string& yaml, const std::string& name, const std::filesystem::path& base_dir,
+                      const std::vector<SceneOverride>& overrides) {
+  SceneReader reader(name, base_dir);
+  try {
+    YAML::Node root = YAML::Load(yaml);
+    scene_detail::apply_overrides(root, overrides, reader);
+    Scene scene = read_scene(reader, root);
+    scene.warnings = reader.warnings();
+    return scene;
+  } catch (const YAML::Exception& e) {
+    // Malformed YAML (or a yaml-cpp failure while reading the tree): never crash, point at it.
+    throw Error(reader.where(e.mark) + ": invalid YAML: " + e.msg);
+  }
+}
+
+Scene load_scene(const std::filesystem::path& file, const std::vector<SceneOverride>& overrides) {
+  // A directory opens as a stream on Linux and reads as nothing; say what it is instead.
+  std::error_code ec;
+  if (std::filesystem::is_directory(file, ec))
+    throw Error(file.string() + ": is a directory, not a scene file");
+  // Refuse enormous files before reading them into memory (a scene is a few kilobytes; generators make
+  // big scenes from a few lines).
+  constexpr std::uintmax_t kMaxSceneBytes = std::uintmax_t{64} << 20;
+  if (const std::uintmax_t size = std::filesystem::file_size(file, ec); !ec && size > kMaxSceneBytes)
+    throw Error(file.string() + ": the scene file is " + std::to_string(size) +
+                " bytes, larger than the limit of " + std::to_string(kMaxSceneBytes) + " bytes (64 MiB)");
+  std::ifstream in(file, std::ios::binary);
+  if (!in) throw Error(file.string() + ": cannot open the scene file: " + std::strerror(errno));
+  std::ostringstream text;
+  text << in.rdbuf();
+  if (in.bad()) throw Error(file.string() + ": cannot read the scene file");
+  if (text.str().empty()) throw Error(file.string() + ": the scene file is empty");
+  Scene scene = load_scene_text(text.str(), file.string(), file.parent_path(), overrides);
+  scene.file = file;
+  return scene;
+}
+
+std::unique_ptr<World> build_world(const Scene& scene, PluginHost& host) {
+  host.prepend_directories(scene.plugin_path);
+  auto world = std::make_unique<World>(scene.settings);
+  std::vector<BodyIndex> index;  // scene index → world index
+  index.reserve(scene.bodies.size());
+  for (const RigidBody& body : scene.bodies) index.push_back(world->add_body(body));
+  for (Constraint constraint : scene.constraints) {
+    std::visit([&](auto& c) { c.a = index.at(c.a), c.b = index.at(c.b); }, constraint);
+    world->add_constraint(constraint);
+  }
+  // The host reads (and marks as read) the options, so each module gets its own copy.
+  ModuleOptions integrator_options = scene.integrator.options;
+  world->set_integrator(host.create_integrator(
+      plugin_request(scene.integrator, ModuleKind::integrator, "momentum", integrator_options)));
+  if (scene.detector.plugin != "none") {
+    ModuleOptions options = scene.detector.options;
+    world->set_detector(host.create_detector(plugin_request(scene.detector, ModuleKind::detector, "fcl", options)));
+  }
+  if (scene.resolver.plugin != "none") {
+    ModuleOptions options = scene.resolver.options;
+    world->set_resolver(
+        host.create_resolver(plugin_request(scene.resolver, ModuleKind::resolver, "ledas", options)));
+  }
+  return world;
+}
+
+}  // namespace impetus

@@ -1,0 +1,249 @@
+#include "impetus/engine/world.hpp"
+
+#include "impetus/core/error.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <string>
+#include <utility>
+
+namespace impetus {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double seconds_since(Clock::time_point start) {
+  return std::chrono::duration<double>(Clock::now() - start).count();
+}
+
+bool state_is_finite(const RigidBody& b) {
+  return all_finite(b.position) && all_finite(b.rotation) && all_finite(b.velocity) &&
+         all_finite(b.angular_velocity);
+}
+
+std::string body_label(const RigidBody& body, std::size_t index) {
+  return "body '" + (body.name.empty() ? "#" + std::to_string(index) : body.name) + "'";
+}
+
+// Physical validity of a body handed to the world. The scene loader checks the same values with file
+// positions; this catches bodies built in code.
+void validate_body(const RigidBody& body, std::size_t index) {
+  const std::string label = body_label(body, index);
+  if (!state_is_finite(body) || !all_finite(body.force) || !all_finite(body.torque))
+    throw Error(label + ": position, rotation, velocities and loads must be finite");
+  if (!((body.rotation.transpose() * body.rotation - Mat3::Identity()).norm() < 1e-9) ||
+      !(body.rotation.determinant() > 0.0))
+    throw Error(label + ": rotation is not a proper rotation matrix");
+  if (std::holds_alternative<Plane>(body.shape) && !body.fixed)
+    throw Error(label + ": a plane is an infinite half-space and must be fixed");
+  if (body.fixed) return;
+  if (!(body.mass > 0.0) || !std::isfinite(body.mass) || !(std::abs(body.inv_mass * body.mass - 1.0) < 1e-9))
+    throw Error(label + ": mass must be positive and finite with inv_mass = 1/mass, got mass " +
+                std::to_string(body.mass));
+  const Eigen::SelfAdjointEigenSolver<Mat3> eig(body.inertia_body);
+  if (!all_finite(body.inertia_body) || !(eig.eigenvalues().minCoeff() > 0.0) ||
+      !((body.inertia_body * body.inv_inertia_body - Mat3::Identity()).norm() < 1e-6))
+    throw Error(label + ": inertia must be symmetric positive definite with a matching inverse");
+}
+
+// The bodies a constraint joins and whether they still collide, whatever its kind.
+struct ConstraintEnds {
+  BodyIndex a, b;
+  bool collide;
+};
+ConstraintEnds ends_of(const Constraint& constraint) {
+  return std::visit([](const auto& c) { return ConstraintEnds{c.a, c.b, c.collide}; }, constraint);
+}
+
+}  // namespace
+
+World::World(WorldSettings settings) : settings_(std::move(settings)) {
+  if (!(settings_.dt > 0.0) || !std::isfinite(settings_.dt))
+    throw Error("world: dt must be positive and finite, got " + std::to_string(settings_.dt));
+  if (!all_finite(settings_.gravity)) throw Error("world: gravity must be finite");
+}
+
+World::~World() = default;
+
+BodyIndex World::add_body(RigidBody body) {
+  validate_body(body, bodies_.size());
+  if (!body.name.empty() && find_body(body.name))
+    throw Error("body '" + body.name + "': a body with this name already exists");
+  if (body.fixed) make_fixed(body);
+  bodies_.push_back(std::move(body));
+  detector_stale_ = true;
+  return static_cast<BodyIndex>(bodies_.size() - 1);
+}
+
+void World::add_constraint(Constraint constraint) {
+  const ConstraintEnds pp = ends_of(constraint);
+  if (pp.a >= bodies_.size() || pp.b >= bodies_.size() || pp.a == pp.b)
+    throw Error("constraint: bodies must be two different existing bodies, got indices " +
+                std::to_string(pp.a) + " and " + std::to_string(pp.b));
+  if (bodies_[pp.a].fixed && bodies_[pp.b].fixed)
+    throw Error("constraint between '" + bodies_[pp.a].name + "' and '" + bodies_[pp.b].name +
+                "': both bodies are fixed");
+  if (resolver_) {
+    const Constraint one[] = {constraint};
+    if (ModuleStatus s = resolver_->accept_constraints(one); !s) throw Error("resolver: " + s.message);
+  }
+  constraints_.push_back(constraint);
+  detector_stale_ = true;
+}
+
+void World::set_integrator(std::shared_ptr<Integrator> integrator) { integrator_ = std::move(integrator); }
+
+void World::set_detector(std::shared_ptr<CollisionDetector> detector) {
+  detector_ = std::move(detector);
+  detector_stale_ = true;
+  sync_detector();
+}
+
+void World::set_resolver(std::shared_ptr<CollisionResolver> resolver) {
+  if (resolver) {
+    if (ModuleStatus s = resolver->accept_constraints(constraints_); !s) throw Error("resolver: " + s.message);
+  }
+  resolver_ = std::move(resolver);
+}
+
+std::optional<BodyIndex> World::find_body(const std::string& name) const {
+  for (std::size_t i = 0; i < bodies_.size(); ++i)
+    if (bodies_[i].name == name) return static_cast<BodyIndex>(i);
+  return std::nullopt;
+}
+
+StepContext World::context() const {
+  return StepContext{settings_.dt, settings_.gravity, step_count_, time_};
+}
+
+// Hands the detector the current bodies and the pairs joined by non-colliding constraints.
+void World::sync_detector() {
+  if (!detector_ || !detector_stale_) return;
+  std::vector<BodyPair> excluded;
+  for (const Constraint& c : constraints_) {
+    const ConstraintEnds pp = ends_of(c);
+    if (!pp.collide) excluded.emplace_back(std::min(pp.a, pp.b), std::max(pp.a, pp.b));
+  }
+  std::sort(excluded.begin(), excluded.end());
+  excluded.erase(std::unique(excluded.begin(), excluded.end()), excluded.end());
+  if (ModuleStatus s = detector_->set_bodies(bodies_, excluded); !s) throw Error("detector: " + s.message);
+  detector_stale_ = false;
+}
+
+void World::detect(StepStatus& status) {
+  const auto start = Clock::now();
+  contacts_.clear();
+  if (detector_) {
+    sync_detector();
+    detector_->detect(bodies_, context(), contacts_, status.detector);
+  }
+  status.profile.detect = seconds_since(start);
+}
+
+void World::resolve(StepStatus& status) {
+  const auto start = Clock::now();
+  if (resolver_ && (!contacts_.empty() || !constraints_.empty()))
+    resolver_->resolve(bodies_, contacts_, constraints_, context(), status.resolver);
+  status.profile.resolve = seconds_since(start);
+}
+
+// A non-finite state never propagates: every body is rolled back to its state before the step and the
+// status names the first offender and the stage that produced it.
+bool World::check_finite(StepStatus& status, const char* stage) {
+  std::size_t first_bad = bodies_.size();
+  for (std::size_t i = 0; i < bodies_.size(); ++i) {
+    if (!state_is_finite(bodies_[i])) {
+      ++status.nan_caught;
+      if (first_bad == bodies_.size()) first_bad = i;
+    }
+  }
+  if (first_bad == bodies_.size()) return true;
+  status.ok = false;
+  status.message = body_label(bodies_[first_bad], first_bad) + " became non-finite during " + stage +
+                   " at step " + std::to_string(step_count_) + "; state restored to before the step";
+  restore_snapshot();
+  return false;
+}
+
+// Only the state is saved (not names or shapes): this runs every step.
+void World::take_snapshot() {
+  snapshot_.resize(bodies_.size());
+  for (std::size_t i = 0; i < bodies_.size(); ++i) {
+    const RigidBody& b = bodies_[i];
+    snapshot_[i] = {b.position, b.rotation, b.velocity, b.angular_velocity};
+  }
+}
+
+void World::restore_snapshot() {
+  for (std::size_t i = 0; i < bodies_.size(); ++i) {
+    RigidBody& b = bodies_[i];
+    const BodyState& s = snapshot_[i];
+    b.position = s.position;
+    b.rotation = s.rotation;
+    b.velocity = s.velocity;
+    b.angular_velocity = s.angular_velocity;
+  }
+}
+
+const StepStatus& World::step() {
+  if (!integrator_) throw Error("world: no integrator set");
+  const auto start = Clock::now();
+  status_ = StepStatus{};
+  take_snapshot();
+  const StepContext ctx = context();
+  const auto timed = [](double& slot, auto&& stage) {
+    const auto t0 = Clock::now();
+    stage();
+    slot = seconds_since(t0);
+  };
+
+  bool ok = true;
+  if (settings_.order == StepOrder::split) {
+    // 1. velocities: gravity and applied loads over dt
+    timed(status_.profile.velocities, [&] { integrator_->integrate_velocities(bodies_, ctx, status_.integrator); });
+    ok = check_finite(status_, "velocity integration");
+    // 2. detect contacts at the current positions
+    if (ok) detect(status_);
+    // 3. resolve: impulses make the predicted velocities admissible
+    if (ok) {
+      resolve(status_);
+      ok = check_finite(status_, "resolution");
+    }
+    // 4. positions: move with the resolved velocities
+    if (ok) {
+      timed(status_.profile.positions, [&] { integrator_->integrate_positions(bodies_, ctx, status_.integrator); });
+      ok = check_finite(status_, "position integration");
+    }
+  } else {
+    // The paper's order (sec. 2): integrate fully, then detect and resolve at the new positions.
+    timed(status_.profile.velocities, [&] { integrator_->integrate_velocities(bodies_, ctx, status_.integrator); });
+    timed(status_.profile.positions, [&] { integrator_->integrate_positions(bodies_, ctx, status_.integrator); });
+    ok = check_finite(status_, "integration");
+    if (ok) detect(status_);
+    if (ok) {
+      resolve(status_);
+      ok = check_finite(status_, "resolution");
+    }
+  }
+
+  if (ok) {
+    ++step_count_;
+    time_ = static_cast<double>(step_count_) * settings_.dt;  // no accumulated rounding in time
+  }
+  status_.profile.total = seconds_since(start);
+  return status_;
+}
+
+const StepStatus& World::detect_and_resolve() {
+  const auto start = Clock::now();
+  status_ = StepStatus{};
+  take_snapshot();
+  detect(status_);
+  resolve(status_);
+  check_finite(status_, "resolution");
+  status_.profile.total = seconds_since(start);
+  return status_;
+}
+
+}  // namespace impetus
