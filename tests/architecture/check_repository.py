@@ -6,6 +6,11 @@
                                         own layer and of the layers it lists, never of a layer above it
   check_repository.py standalone ROOT   no file points outside the repository (to the developers' shared
                                         folder beside it), and every relative Markdown link resolves inside it
+  check_repository.py libraries ROOT LIBDIR
+                                        the built libraries link as the layers say (readelf -d): a layer's
+                                        libimpetus_<layer>.so needs only the libraries of the layers it may
+                                        include, a plugin needs no Impetus library, and yaml-cpp, assimp and
+                                        FCL are linked only by the engine, the assets and the fcl plugin
 
 Each failure is printed as FILE:LINE: problem; the exit status is 1 when there is any.
 """
@@ -148,14 +153,57 @@ def check_standalone(root):
     return failures
 
 
+# Third-party libraries that belong to one layer or plugin only (docs/architecture.md).
+FOREIGN_OWNERS = {'libyaml-cpp': 'engine', 'libassimp': 'assets', 'libfcl': 'impetus_detector_fcl',
+                  'libccd': 'impetus_detector_fcl'}
+
+
+def needed(path):
+    out = subprocess.run(['readelf', '-d', path], check=True, capture_output=True, text=True).stdout
+    return re.findall(r'\(NEEDED\)\s+Shared library: \[([^\]]+)\]', out)
+
+
+def check_libraries(root, libdir):
+    layers = read_layers(root)
+    failures, seen = [], 0
+    plugin_dir = os.path.join(libdir, 'impetus', 'plugins')
+    candidates = [(os.path.join(libdir, n), n[len('libimpetus_'):-len('.so')]) for n in sorted(os.listdir(libdir))
+                  if n.startswith('libimpetus_') and n.endswith('.so')]
+    if os.path.isdir(plugin_dir):
+        candidates += [(os.path.join(plugin_dir, n), None) for n in sorted(os.listdir(plugin_dir)) if n.endswith('.so')]
+    for path, layer in candidates:
+        name = os.path.basename(path)
+        if layer is not None and layer not in layers:
+            failures.append(f'{path}: libimpetus_{layer}.so is no layer of docs/architecture.md')
+            continue
+        seen += 1
+        allowed = set() if layer is None else set(layers[layer][2]) | {layer}
+        owner = layer if layer is not None else name[:-len('.so')]
+        for lib in needed(path):
+            m = re.match(r'libimpetus_(\w+)\.so', lib)
+            if m and m.group(1) not in allowed:
+                what = 'a plugin' if layer is None else f'layer {layer}'
+                failures.append(f'{path}: {what} links {lib} (layer {m.group(1)}), which it may not use')
+            for prefix, lib_owner in FOREIGN_OWNERS.items():
+                if lib.startswith(prefix) and owner != lib_owner:
+                    failures.append(f'{path}: links {lib}, which only {lib_owner} may link')
+    if seen < 4:
+        failures.append(f'{libdir}: found {seen} Impetus libraries; expected the layers and the plugins')
+    return failures
+
+
 def main():
-    if len(sys.argv) != 3 or sys.argv[1] not in ('layers', 'standalone'):
+    mode = sys.argv[1] if len(sys.argv) > 1 else ''
+    if (mode, len(sys.argv)) not in (('layers', 3), ('standalone', 3), ('libraries', 4)):
         sys.exit(__doc__)
     root = os.path.abspath(sys.argv[2])
-    failures = check_layers(root) if sys.argv[1] == 'layers' else check_standalone(root)
+    if mode == 'libraries':
+        failures = check_libraries(root, sys.argv[3])
+    else:
+        failures = check_layers(root) if mode == 'layers' else check_standalone(root)
     for failure in failures:
         print(failure)
-    print(f'{sys.argv[1]}: {len(failures)} problem(s)')
+    print(f'{mode}: {len(failures)} problem(s)')
     return 1 if failures else 0
 
 
