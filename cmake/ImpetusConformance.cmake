@@ -21,20 +21,22 @@ include(GoogleTest)
 # The library that provides the plugin host (impetus/plugins/host.hpp) to the suites: the only link.
 set(IMPETUS_CONFORMANCE_HOST_TARGET Impetus::core)
 
-# The suites' objects, compiled once per kind and shared by every executable that tests one plugin.
+# The objects of one kind's suite (and the shared support), compiled once per project and shared by
+# every executable that tests a plugin of that kind. Only the kinds asked for are built.
 function(_impetus_conformance_objects kind)
-  if(TARGET impetus_conformance_support)
-    return()
-  endif()
   if(NOT TARGET GTest::gtest)
     find_package(GTest REQUIRED)
   endif()
-  add_library(impetus_conformance_support OBJECT "${IMPETUS_CONFORMANCE_DIR}/src/support.cpp")
-  foreach(suite integrator detector resolver)
-    add_library(impetus_conformance_${suite} OBJECT "${IMPETUS_CONFORMANCE_DIR}/src/${suite}_suite.cpp")
-  endforeach()
-  foreach(objects impetus_conformance_support impetus_conformance_integrator impetus_conformance_detector
-                  impetus_conformance_resolver)
+  set(created "")
+  if(NOT TARGET impetus_conformance_support)
+    add_library(impetus_conformance_support OBJECT "${IMPETUS_CONFORMANCE_DIR}/src/support.cpp")
+    list(APPEND created impetus_conformance_support)
+  endif()
+  if(NOT TARGET impetus_conformance_${kind})
+    add_library(impetus_conformance_${kind} OBJECT "${IMPETUS_CONFORMANCE_DIR}/src/${kind}_suite.cpp")
+    list(APPEND created impetus_conformance_${kind})
+  endif()
+  foreach(objects IN LISTS created)
     target_include_directories(${objects} PUBLIC "${IMPETUS_CONFORMANCE_DIR}/include")
     target_link_libraries(${objects} PUBLIC ${IMPETUS_CONFORMANCE_HOST_TARGET} GTest::gtest)
     target_compile_features(${objects} PUBLIC cxx_std_20)
