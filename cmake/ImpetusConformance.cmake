@@ -10,7 +10,8 @@
 #   LABEL               test-name suffix (default: the plugin's name); letters, digits and _
 #   OPTIONS             options every module is created with, as a scene would write them (mode=paper)
 #   CLAIMS              capabilities beyond the contract that the plugin documents, each enabling a test:
-#                       integrator `angular_momentum` (L conserved without torque), detector `margin`
+#                       integrator `angular_momentum` (L conserved without torque), resolver `elastic`
+#                       (kinetic energy conserved when every e = 1), detector `margin`
 #                       (reads the option `margin`; gaps within it are contacts of depth −gap)
 #   APPROACH_TOLERANCE  resolvers: the largest v_n < 0 (m/s) left at a contact, default 1e-6
 # Needs GoogleTest (find_package(GTest)) and the variable IMPETUS_CONFORMANCE_DIR (set by Impetus's

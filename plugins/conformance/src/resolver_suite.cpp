@@ -52,11 +52,11 @@ Scene cluster(unsigned seed, double e) {
   return s;
 }
 
-/// Every cluster the scene tests run: five seeds for each uniform e.
+/// Every cluster the scene tests run: twenty seeds for each uniform e.
 template <typename F>
 void for_each_cluster(F&& check) {
   for (const double e : kRestitutions)
-    for (unsigned seed = 1; seed <= 5; ++seed) {
+    for (unsigned seed = 1; seed <= 20; ++seed) {
       SCOPED_TRACE("cluster seed " + std::to_string(seed) + ", e = " + std::to_string(e));
       Scene s = cluster(seed, e);
       check(s, e);
@@ -65,7 +65,7 @@ void for_each_cluster(F&& check) {
 
 // Law: a single head-on contact between spheres m1, m2 approaching along n = +x at u1 > u2, uniform e:
 //   v1 = (m1 u1 + m2 u2 − m2 e (u1 − u2)) / (m1 + m2),  v2 = (m1 u1 + m2 u2 + m1 e (u1 − u2)) / (m1 + m2),
-// impulse p = m1 (u1 − v1); nothing moves sideways or spins (central impact). 1e-12, every e in
+// impulse p = m1 (u1 − v1); nothing moves sideways or spins (central impact: 1e-15). 1e-12, every e in
 // {0, 0.25, 0.5, 1}. Counters: one island, one contact, at least one round, nothing pulling, non-finite,
 // singular or unconverged, residual within the resolver's tolerance.
 TEST_P(ResolverConformance, SingleHeadOnContactFollowsTheClosedForm) {
@@ -83,7 +83,7 @@ TEST_P(ResolverConformance, SingleHeadOnContactFollowsTheClosedForm) {
       EXPECT_NEAR(bodies[0].velocity.x(), v1, kExact);
       EXPECT_NEAR(bodies[1].velocity.x(), v2, kExact);
       EXPECT_NEAR(contacts[0].impulse, m1 * (u1 - v1), kExact);
-      for (const RigidBody& b : bodies) EXPECT_LT(b.velocity.tail<2>().norm() + b.angular_velocity.norm(), kExact);
+      for (const RigidBody& b : bodies) EXPECT_LT(b.velocity.tail<2>().norm() + b.angular_velocity.norm(), 1e-15);
       EXPECT_EQ(c.islands, 1u);
       EXPECT_EQ(c.contacts, 1u);
       EXPECT_GE(c.rounds, 1u);
@@ -186,14 +186,15 @@ TEST_P(ResolverConformance, ConservesMomentumInGravityFreeScenes) {
 }
 
 // Law: with one e ≤ 1 for every contact, an impact never adds kinetic energy: E⁺ ≤ E (1 + 1e-12), and the
-// resolver reports no energy_gain_events; perfectly elastic (e = 1), it keeps it: |E⁺ − E| ≤ 1e-12 E.
+// resolver reports no energy_gain_events. Claim `elastic`: at e = 1 it keeps it, |E⁺ − E| ≤ 1e-12 E (a
+// resolver that does not bounce slow contacts, e.g. below a bounce threshold, loses some).
 TEST_P(ResolverConformance, NeverGainsEnergyWithUniformRestitution) {
   const auto resolver = load_resolver(GetParam());
   for_each_cluster([&](Scene& s, double e) {
     const double e0 = kinetic_energy(s.bodies);
     const ResolverCounters c = resolve(*resolver, s.bodies, s.contacts);
     EXPECT_LE(kinetic_energy(s.bodies), e0 * (1 + kExact));
-    if (e == 1.0) {
+    if (e == 1.0 && GetParam().claims_capability("elastic")) {
       EXPECT_NEAR(kinetic_energy(s.bodies), e0, kExact * e0);
     }
     EXPECT_EQ(c.energy_gain_events, 0u);

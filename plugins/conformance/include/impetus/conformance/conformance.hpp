@@ -39,6 +39,7 @@ struct PluginUnderTest {
   std::vector<std::pair<std::string, std::string>> options;
   /// Documented capabilities that enable extra tests:
   ///   integrator `angular_momentum` — conserves L without torque (a tumbling asymmetric body);
+  ///   resolver `elastic` — conserves kinetic energy when every contact has e = 1;
   ///   detector `margin` — reads the option `margin` (m): gaps up to it are contacts of depth −gap.
   std::set<std::string> claims;
   /// Largest approach velocity (m/s) a resolver may leave at a contact (resolvers: its touch tolerance).
