@@ -3,8 +3,8 @@
 // overlaps and < 0 is a gap within the detector's margin; the list is sorted deterministically.
 #include "impetus/conformance/conformance.hpp"
 
-#include <algorithm>
 #include <cmath>
+#include <utility>
 
 namespace impetus::conformance {
 namespace {
@@ -22,7 +22,7 @@ std::vector<Contact> detect(CollisionDetector& detector, const std::vector<Rigid
   return contacts;
 }
 
-/// A fixed or movable body of `shape` at `position` (mass properties do not matter to a detector).
+/// A movable body of `shape` at `position` (mass properties do not matter to a detector).
 RigidBody placed(const Shape& shape, const Vec3& position, const Mat3& rotation = Mat3::Identity()) {
   RigidBody b = principal_body(1.0, Vec3::Ones());
   b.shape = shape;

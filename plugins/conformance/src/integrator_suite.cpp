@@ -3,6 +3,7 @@
 // the world calls them with no contacts.
 #include "impetus/conformance/conformance.hpp"
 
+#include <algorithm>
 #include <cmath>
 
 namespace impetus::conformance {
