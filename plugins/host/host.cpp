@@ -4,6 +4,7 @@
 #include "impetus/plugins/host.hpp"
 
 #include "impetus/core/error.hpp"
+#include "impetus/plugins/layout.hpp"
 
 #include <dlfcn.h>
 
@@ -136,6 +137,20 @@ std::string check_identity(const PluginDescriptor& d, ModuleKind kind, const std
   return {};
 }
 
+/// "" if every layout word of the plugin matches the host's; otherwise the types that differ, each with
+/// both words.
+std::string layout_mismatch(const LayoutWords& plugin) {
+  const LayoutWords host = plugin_layout_words();
+  std::vector<std::string> differing;
+  for (std::size_t type = 0; type < kLayoutTypeCount; ++type)
+    if (plugin[type] != host[type])
+      differing.push_back(std::string(kLayoutTypeNames[type]) + " (plugin: " + hex(plugin[type]) +
+                          ", host: " + hex(host[type]) + ")");
+  if (differing.empty()) return {};
+  return "layout mismatch: the plugin was built with a different layout of " + join(differing, ", ") +
+         "; rebuild it against this Impetus";
+}
+
 /// Owns a module: destroys it with its own plugin's code, then lets go of the library (which may
 /// unload it), in that order.
 struct ModuleDeleter {
@@ -258,6 +273,8 @@ std::shared_ptr<LoadedLibrary> PluginHost::load(const fs::path& file, std::strin
              hex(host_word) + ")";
     return nullptr;
   }
+  reason = layout_mismatch(d->layout_words);
+  if (!reason.empty()) return nullptr;
   if (d->kind < 1 || d->kind > 3) {
     reason = "invalid descriptor: it declares " + kind_with_article(d->kind);
     return nullptr;

@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
-# usage: run_embed_example.sh BUILD_DIR EXAMPLE_SRC WORK_DIR
+# usage: run_embed_example.sh BUILD_DIR EXAMPLE_SRC WORK_DIR [PLUGIN_TEMPLATE_SRC]
 set -euo pipefail
-build=$1 example=$2 work=$3
+build=$1 example=$2 work=$3 template=${4:-}
 rm -rf "$work"
 mkdir -p "$work"
 cmake --install "$build" --prefix "$work/staging" >/dev/null
@@ -14,3 +14,12 @@ cmake --build "$work/build" >/dev/null
 # Meshes are imported by the importer program, which the relocated library must find in its own prefix.
 mass=$("$work/prefix/bin/impetus" mass "$work/prefix/share/impetus/meshes/cube.obj" 2>&1) || {
   echo "installed impetus cannot import a mesh: $mass" >&2; exit 1; }
+# The plugin template, built out of tree against the relocated install, passes the integrator
+# conformance suite that the install ships (impetus_add_conformance_tests()).
+if [[ -n "$template" ]]; then
+  cmake -S "$template" -B "$work/template" -G Ninja -DCMAKE_PREFIX_PATH="$work/prefix" >/dev/null
+  cmake --build "$work/template" >/dev/null
+  ctest --test-dir "$work/template" --output-on-failure >/dev/null || {
+    echo "the plugin template fails the installed conformance suite" >&2
+    ctest --test-dir "$work/template" --output-on-failure >&2; exit 1; }
+fi

@@ -44,6 +44,7 @@ TEST(PluginDiscover, ListsGoodPluginsAndReportsEveryBrokenFixture) {
       {"fixture_abi", "ABI version mismatch"},
       {"fixture_size", "descriptor size mismatch"},
       {"fixture_config", "build configuration mismatch"},
+      {"fixture_layout", "layout mismatch: the plugin was built with a different layout of impetus::Contact"},
       {"fixture_kind", "wrong kind: it declares a resolver named 'fixture_kind', expected an integrator"},
       {"fixture_misnamed", "name mismatch: it declares 'fixture_other', expected 'fixture_misnamed'"},
   };
@@ -57,7 +58,7 @@ TEST(PluginDiscover, ListsGoodPluginsAndReportsEveryBrokenFixture) {
   const auto in_fixture_dir = [](const fs::path& p) { return p.parent_path() == fixture_dir(); };
   EXPECT_EQ(std::count_if(listing.failures.begin(), listing.failures.end(),
                           [&](const auto& f) { return in_fixture_dir(f.path); }),
-            8);
+            9);
   EXPECT_FALSE(is_loaded(integrator_fixture("fixture_good"))) << "discover does not keep libraries";
 }
 

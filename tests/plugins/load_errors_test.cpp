@@ -1,6 +1,10 @@
 // One test per way a plugin can fail to load. Each asserts that impetus::Error is thrown and that its
 // message names the problem, the file tried, and the expected and found values.
+#include "larger_contact.hpp"
 #include "plugin_test_support.hpp"
+
+#include <cinttypes>
+#include <cstdio>
 
 namespace {
 
@@ -54,6 +58,28 @@ TEST(PluginLoadErrors, ConfigWordMismatchDescribesBothBuilds) {
   expect_contains(message, {load_failure("fixture_config") + "build configuration mismatch",
                             "the plugin was built with [" + impetus::describe_config_word(plugin_word) + "]",
                             "this Impetus with [" + impetus::describe_config_word(host_word) + "]"});
+}
+
+// fixture_layout reports the layout word of a Contact with one more field: the host refuses it and
+// names impetus::Contact with both words, and no other type (every other word agrees).
+TEST(PluginLoadErrors, LayoutMismatchNamesTheTypeThatDiffers) {
+  auto host = fixture_host();
+  const std::string message = error_message([&] { host.create_integrator(integrator_request("fixture_layout")); });
+  const impetus::LayoutWords host_words = impetus::plugin_layout_words();
+  const std::uint64_t host_contact = host_words[static_cast<std::size_t>(impetus::LayoutType::contact)];
+  const std::uint64_t plugin_contact = impetus_fixtures::larger_contact_layout_word();
+  ASSERT_NE(plugin_contact, host_contact);
+  char expected[160];
+  std::snprintf(expected, sizeof expected, "impetus::Contact (plugin: 0x%016" PRIx64 ", host: 0x%016" PRIx64 ")",
+                plugin_contact, host_contact);
+  expect_contains(message, {load_failure("fixture_layout") +
+                                "layout mismatch: the plugin was built with a different layout of " + expected,
+                            "; rebuild it against this Impetus"});
+  for (std::size_t type = 0; type < impetus::kLayoutTypeCount; ++type) {
+    if (type == static_cast<std::size_t>(impetus::LayoutType::contact)) continue;
+    EXPECT_EQ(message.find(std::string(impetus::kLayoutTypeNames[type]) + " ("), std::string::npos)
+        << impetus::kLayoutTypeNames[type] << " agrees and must not be named: " << message;
+  }
 }
 
 TEST(PluginLoadErrors, WrongKindFoundByName) {

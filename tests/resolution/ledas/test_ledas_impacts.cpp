@@ -1,5 +1,7 @@
-// LEDAS resolver, small impacts with analytic answers: head-on and oblique spheres, a box corner,
-// the paper's Figure 1, Newton's cradle, conservation laws, mixed restitution and gap contacts.
+// LEDAS resolver, small impacts specific to it: a box corner in both modes, the paper's Figure 1,
+// Newton's cradle, mixed restitution and gap contacts. The contract's laws (single-contact closed forms,
+// oblique impacts, momentum and energy in gravity-free clusters, residual ≤ 1e-9) are checked in both
+// modes by the resolver conformance suite (plugins/conformance, tests/conformance).
 #include "ledas_test_support.hpp"
 
 #include <gtest/gtest.h>
@@ -13,43 +15,6 @@ namespace {
 using namespace ledas_test;
 
 constexpr LedasMode kModes[] = {LedasMode::paper, LedasMode::complementary};
-
-// 1D impact of two spheres: v1' = (m1 u1 + m2 u2 − m2 e (u1 − u2)) / (m1 + m2), and symmetrically (1e-12).
-TEST(LedasImpacts, HeadOnSpheresMatchTheOneDimensionalFormulas) {
-  for (LedasMode mode : kModes)
-    for (auto [m1, m2] : {std::pair{1.0, 1.0}, std::pair{1.0, 3.0}, std::pair{5.0, 0.5}})
-      for (double e : {0.0, 0.5, 1.0}) {
-        const double u1 = 2.0, u2 = -0.5;
-        std::vector<RigidBody> bodies{sphere(0.5, m1, {0, 0, 0}, {u1, 0, 0}, e), sphere(0.5, m2, {1, 0, 0}, {u2, 0, 0}, e)};
-        std::vector<Contact> contacts{contact(0, 1, {0.5, 0, 0}, Vec3::UnitX())};
-        LedasResolver resolver(settings_for(mode));
-        const ResolverCounters c = resolve(resolver, bodies, contacts);
-        const double v1 = (m1 * u1 + m2 * u2 - m2 * e * (u1 - u2)) / (m1 + m2);
-        const double v2 = (m1 * u1 + m2 * u2 + m1 * e * (u1 - u2)) / (m1 + m2);
-        EXPECT_NEAR(bodies[0].velocity.x(), v1, 1e-12);
-        EXPECT_NEAR(bodies[1].velocity.x(), v2, 1e-12);
-        EXPECT_NEAR(contacts[0].impulse, m1 * (u1 - v1), 1e-12);
-        EXPECT_LT(bodies[0].velocity.tail<2>().norm() + bodies[0].angular_velocity.norm(), 1e-15);
-        EXPECT_EQ(c.islands, 1u);
-        EXPECT_EQ(c.contacts, 1u);
-        EXPECT_EQ(c.pulling_impulses, 0u);
-      }
-}
-
-// Oblique impact: the normal components follow the 1D law, the tangential ones are untouched (1e-12).
-TEST(LedasImpacts, ObliqueImpactKeepsTangentialVelocity) {
-  const double r = 0.5, e = 0.5;
-  const Vec3 n = Vec3(std::cos(0.5), std::sin(0.5), 0.2).normalized();
-  const Vec3 u1(1.0, 0.4, -0.3), u2(-0.2, 0.1, 0.5);
-  std::vector<RigidBody> bodies{sphere(r, 2.0, Vec3::Zero(), u1, e), sphere(r, 1.0, 2 * r * n, u2, e)};
-  std::vector<Contact> contacts{contact(0, 1, r * n, n)};
-  LedasResolver resolver;
-  resolve(resolver, bodies, contacts);
-  const double a1 = u1.dot(n), a2 = u2.dot(n);
-  const double b1 = (2 * a1 + a2 - e * (a1 - a2)) / 3.0, b2 = (2 * a1 + a2 + 2 * e * (a1 - a2)) / 3.0;
-  EXPECT_LT((bodies[0].velocity - (u1 + (b1 - a1) * n)).norm(), 1e-12);
-  EXPECT_LT((bodies[1].velocity - (u2 + (b2 - a2) * n)).norm(), 1e-12);
-}
 
 // A tilted box hits the ground on one corner: p = −(1 + e) v_n / (1/m + (r×n)·J⁻¹(r×n)), v_n⁺ = −e v_n
 // (1e-12), identical in both modes.
@@ -141,47 +106,6 @@ TEST(LedasImpacts, NewtonsCradleInBothModes) {
       EXPECT_EQ(c.rounds, 4u);
     }
   }
-}
-
-// Random gravity-free clusters of spheres and boxes, uniform e in {0, 0.5, 1}: linear and angular
-// momentum conserved (1e-12), kinetic energy never rises (exactly conserved for e = 1, 1e-12).
-TEST(LedasImpacts, ConservesMomentumAndNeverGainsEnergyWithUniformRestitution) {
-  std::mt19937 rng(7);
-  std::uniform_real_distribution<double> u(-1.0, 1.0);
-  for (LedasMode mode : kModes)
-    for (double e : {0.0, 0.5, 1.0})
-      for (int trial = 0; trial < 20; ++trial) {
-        // A small hexagonal cluster of touching spheres with random masses and velocities.
-        std::vector<RigidBody> bodies;
-        for (int i = 0; i < 7; ++i) {
-          const Vec3 x = i == 0 ? Vec3::Zero() : Vec3(std::cos(i * M_PI / 3), std::sin(i * M_PI / 3), 0.0);
-          bodies.push_back(sphere(0.5, 0.5 + u(rng) + 1.0, x, Vec3(u(rng), u(rng), u(rng)), e));
-          bodies.back().angular_velocity = Vec3(u(rng), u(rng), u(rng));
-        }
-        std::vector<Contact> contacts = sphere_contacts(bodies);
-        ASSERT_EQ(contacts.size(), 12u);
-        // … and two boxes pressed together on a face with four corner contacts, tilted and spinning.
-        const Mat3 r = Eigen::AngleAxisd(u(rng), Vec3(u(rng), u(rng), 1).normalized()).toRotationMatrix();
-        const BodyIndex b0 = static_cast<BodyIndex>(bodies.size());
-        bodies.push_back(solid(Box{Vec3(1, 1, 1)}, 1.5, Vec3(10, 0, 0), Vec3(u(rng), u(rng), 1 + u(rng)), e, r));
-        bodies.push_back(solid(Box{Vec3(0.8, 0.6, 1)}, 0.7, Vec3(10, 0, 0) + r.col(2), Vec3(u(rng), u(rng), u(rng)), e, r));
-        bodies[b0].angular_velocity = Vec3(u(rng), u(rng), u(rng));
-        for (int k = 0; k < 4; ++k)
-          contacts.push_back(contact(b0, b0 + 1, bodies[b0].position + r * Vec3(k & 1 ? 0.4 : -0.4, k & 2 ? 0.3 : -0.3, 0.5), r.col(2)));
-        const Vec3 p0 = momentum(bodies), l0 = angular_momentum(bodies);
-        const double e0 = kinetic_energy(bodies);
-        LedasResolver resolver(settings_for(mode));
-        const ResolverCounters c = resolve(resolver, bodies, contacts);
-        EXPECT_LT((momentum(bodies) - p0).norm(), 1e-12);
-        EXPECT_LT((angular_momentum(bodies) - l0).norm(), 1e-12);
-        EXPECT_LE(kinetic_energy(bodies), e0 * (1 + 1e-12));
-        if (e == 1.0) {
-          EXPECT_NEAR(kinetic_energy(bodies), e0, 1e-12 * e0);
-        }
-        EXPECT_EQ(c.energy_gain_events, 0u);
-        EXPECT_EQ(c.non_converged, 0u);
-        EXPECT_LE(c.residual, 1e-9);
-      }
 }
 
 // Mixed restitution and the simultaneous rule: A moving at 1 hits B touching C, e(A–B) = 1, e(B–C) = 0.

@@ -5,12 +5,14 @@
 /// A plugin library exports exactly one symbol, `extern "C" impetus_plugin_descriptor`, a function
 /// returning a pointer to a static PluginDescriptor. The host checks, in this order: the ABI version,
 /// the descriptor's size, the config word (build settings that change the layout of shared types),
+/// the layout words (the layout of every type that crosses the boundary, impetus/plugins/layout.hpp),
 /// the kind, and the name; then calls `create`. Objects a plugin creates are destroyed by its own
 /// `destroy`, and the library stays loaded while any of them lives.
 ///
 /// Across the boundary: no exceptions (create reports failure through its error buffer), no
 /// dynamic_cast (the kind says which base class the returned pointer is), no host singletons.
 
+#include <array>
 #include <cstddef>
 #include <cstdint>
 #include <string>
@@ -20,7 +22,8 @@ namespace impetus {
 class ModuleOptions;
 
 /// Version of this ABI. Bump on any change to PluginDescriptor or to the module interfaces.
-inline constexpr std::uint32_t kPluginAbiVersion = 1;
+/// 2: the descriptor carries the layout words.
+inline constexpr std::uint32_t kPluginAbiVersion = 2;
 
 /// Name of the entry symbol every plugin exports.
 inline constexpr const char* kPluginEntrySymbol = "impetus_plugin_descriptor";
@@ -37,6 +40,27 @@ inline const char* module_kind_name(ModuleKind kind) {
   }
   return "unknown";
 }
+
+/// The types whose objects cross the plugin boundary by memory layout (passed by pointer, reference or
+/// span between host and plugin). Each has one layout word in the descriptor, at this index.
+enum class LayoutType : std::uint32_t {
+  rigid_body, material, shape, sphere, box, capsule, cylinder, plane, mesh_shape, triangle_mesh,
+  contact, point_point_constraint, coaxial_constraint, constraint, step_context, integrator_counters,
+  detector_counters, resolver_counters, module_status, module_options, option_value, body_pair,
+  count  ///< not a type: the number of layout words
+};
+/// Number of layout words in a descriptor.
+inline constexpr std::size_t kLayoutTypeCount = static_cast<std::size_t>(LayoutType::count);
+/// The qualified C++ name of each LayoutType, for messages.
+inline constexpr std::array<const char*, kLayoutTypeCount> kLayoutTypeNames{
+    "impetus::RigidBody", "impetus::Material", "impetus::Shape", "impetus::Sphere", "impetus::Box",
+    "impetus::Capsule", "impetus::Cylinder", "impetus::Plane", "impetus::MeshShape", "impetus::TriangleMesh",
+    "impetus::Contact", "impetus::PointPointConstraint", "impetus::CoaxialConstraint", "impetus::Constraint",
+    "impetus::StepContext", "impetus::IntegratorCounters", "impetus::DetectorCounters",
+    "impetus::ResolverCounters", "impetus::ModuleStatus", "impetus::ModuleOptions", "impetus::OptionValue",
+    "impetus::BodyPair"};
+/// One layout word per LayoutType (plugin_layout_words() of a build).
+using LayoutWords = std::array<std::uint64_t, kLayoutTypeCount>;
 
 /// Factory signature: builds a module from its options. On failure returns null and writes a message
 /// (NUL-terminated, at most `error_capacity` bytes) into `error`. Never throws.
@@ -55,6 +79,7 @@ struct PluginDescriptor {
   const char* summary;            ///< one line for `impetus plugins`
   PluginCreateFn create;
   PluginDestroyFn destroy;
+  LayoutWords layout_words;       ///< plugin_layout_words() of the plugin's build, by LayoutType
 };
 
 /// Signature of the entry symbol.

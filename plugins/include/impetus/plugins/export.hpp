@@ -14,6 +14,7 @@
 #include "impetus/modules/options.hpp"
 #include "impetus/modules/resolver.hpp"
 #include "impetus/plugins/abi.hpp"
+#include "impetus/plugins/layout.hpp"
 
 #include <cstdio>
 #include <exception>
@@ -63,6 +64,7 @@ void destroy(void* module) noexcept {
         VERSION,                                                                                      \
         SUMMARY,                                                                                      \
         &::impetus::plugin_detail::create<Base, Class>,                                               \
-        &::impetus::plugin_detail::destroy<Base>};                                                    \
+        &::impetus::plugin_detail::destroy<Base>,                                                     \
+        ::impetus::plugin_layout_words()};                                                            \
     return &descriptor;                                                                               \
   }

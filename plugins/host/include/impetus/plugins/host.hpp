@@ -75,9 +75,10 @@ class PluginHost {
 
   /// Loads the plugin and creates a module. Throws Error with a message for each failure: unknown name
   /// (listing the available plugins of that kind and the directories searched), dlopen failure (its
-  /// text), missing entry symbol, ABI version or descriptor size mismatch, config word mismatch, wrong
-  /// kind, name mismatch, duplicate name (two different libraries loaded for one kind and name), a
-  /// factory that fails (its message), or options the plugin does not know. Messages start with
+  /// text), missing entry symbol, ABI version or descriptor size mismatch, config word mismatch, layout
+  /// mismatch (naming each type whose layout word differs), wrong kind, name mismatch, duplicate name
+  /// (two different libraries loaded for one kind and name), a factory that fails (its message), or
+  /// options the plugin does not know. Messages start with
   /// `request.where` and name the file tried; plugins/README.md lists them all.
   /// The kind is the function's (request.kind is ignored). With `request.file`, that file is loaded
   /// whatever its name, and must declare `request.name` if one is given; by name, the first
