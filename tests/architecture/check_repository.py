@@ -124,7 +124,7 @@ def check_layers(root):
     return failures
 
 
-OUTSIDE = re.compile(r'\.\./' + 'shared' + r'|\bshared/(DESIGN|STYLE)\.md|\bshared/papers/|\bshared/hooks/'
+OUTSIDE = re.compile(r'\.\./' + 'shared' + r'|\bshared/(DESIGN|STYLE)\.md|\bshared/' + r'(papers|hooks)/'
                      + r'|\b' + 'DESIGN' + r'\.md\b|\b' + 'STYLE' + r'\.md\b')
 LINK = re.compile(r'\]\(([^)\s]+)\)')
 
