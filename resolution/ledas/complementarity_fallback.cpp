@@ -1,7 +1,8 @@
 // Complementarity problems: the two minimum-norm pieces around the proximal active set of
 // complementarity.cpp — the fallback for problems without an exact solution, and the minimum-norm
 // impulse split of a small final system.
-#include "ledas/island_solver.hpp"
+#include "ledas/complementarity_solver.hpp"
+#include "ledas/primal_step.hpp"
 #include "ledas/solver_internal.hpp"
 
 #include <algorithm>
@@ -14,7 +15,7 @@ namespace impetus::ledas {
 // inconsistent singular system: conflicting targets, where the regularized iterates drift): each free
 // set solved by minimum-norm least squares, whose residual is then a null direction followed to the
 // first bound.
-Vector IslandSolver::solve_complementarity_min_norm(const ComplementarityProblem& problem, SolverStats& stats) {
+Vector ComplementaritySolver::solve_min_norm(const ComplementarityProblem& problem, SolverStats& stats) {
   const SparseMatrix& a = *problem.matrix;
   const auto m = static_cast<std::size_t>(a.rows());
   const Vector& c = problem.rhs;
@@ -29,7 +30,7 @@ Vector IslandSolver::solve_complementarity_min_norm(const ComplementarityProblem
     const std::vector<RowIndex> rows = members(free_rows);
     Vector z = Vector::Zero(a.rows());
     {
-      const Vector part = solve_system(principal_submatrix(a, rows), gather(c, rows), stats);
+      const Vector part = equalities_.solve_system(principal_submatrix(a, rows), gather(c, rows), stats);
       for (std::size_t i = 0; i < rows.size(); ++i) z(rows[i]) = part(static_cast<Eigen::Index>(i));
     }
     const bool singular = stats.singular != singular_before;
@@ -66,32 +67,18 @@ Vector IslandSolver::solve_complementarity_min_norm(const ComplementarityProblem
       if (!feasible) direction = z - p;
     }
     if (direction.size() > 0) {
-      // Ratio test: the largest step keeping every free inequality row ≥ 0.
-      double step = std::numeric_limits<double>::infinity();
-      std::size_t blocking = m;
-      for (std::size_t k = 0; k < m; ++k) {
-        const auto i = static_cast<Eigen::Index>(k);
-        if (!free_rows[k] || !inequality(k) || !(direction(i) < 0.0)) continue;
-        const double ratio = std::max(0.0, p(i)) / -direction(i);
-        if (ratio < step) step = ratio, blocking = k;
-      }
-      if (blocking == m) {  // the objective falls without bound: the problem has no solution
+      // The largest step keeping every free inequality row ≥ 0 (at most 1 towards z, unbounded along
+      // the null direction); the blocking row is released even when the step is cut to 1.
+      RatioTest test = ratio_test(p, direction, free_rows, problem.equality, std::numeric_limits<double>::infinity());
+      if (test.blocking == m) {  // the objective falls without bound: the problem has no solution
         infeasible = true;
         ++stats.infeasible;
         break;
       }
-      if (!along_null) step = std::min(step, 1.0);
-      p += step * direction;
-      const double floor = kImpulseRoundoff * p.lpNorm<Eigen::Infinity>();
-      for (std::size_t k = 0; k < m; ++k) {
-        const auto i = static_cast<Eigen::Index>(k);
-        const bool falling = along_null ? direction(i) < 0.0 : z(i) < -roundoff;
-        if (free_rows[k] && inequality(k) && (k == blocking || (falling && p(i) <= floor))) {
-          free_rows[k] = 0;
-          p(i) = 0.0;
-          ++stats.released;
-        }
-      }
+      if (!along_null) test.step = std::min(test.step, 1.0);
+      // Falling: along the null direction, the rows it lowers; towards z, the rows z puts below zero.
+      step_and_release(p, direction, test, along_null ? direction : z, along_null ? 0.0 : roundoff, free_rows,
+                       problem.equality, stats);
       continue;
     }
     p = z;
@@ -113,8 +100,7 @@ Vector IslandSolver::solve_complementarity_min_norm(const ComplementarityProblem
     }
   }
   if (!converged && !not_finite && !infeasible) ++stats.non_converged;
-  for (std::size_t k = 0; k < m; ++k)
-    if (inequality(k)) p(static_cast<Eigen::Index>(k)) = free_rows[k] ? std::max(p(static_cast<Eigen::Index>(k)), 0.0) : 0.0;
+  clamp_to_free_set(p, free_rows, problem.equality);
   return p;
 }
 
@@ -122,7 +108,7 @@ Vector IslandSolver::solve_complementarity_min_norm(const ComplementarityProblem
 // it, take the minimum-norm one (the paper's choice for its Figure 2: the impulse shared equally among
 // collinear contacts) if it keeps every impulse ≥ 0. It changes no velocity: p − p_min is a
 // self-equilibrated impulse set (A (p − p_min) = 0).
-void IslandSolver::polish_minimum_norm(const SparseMatrix& a, const Vector& c, std::vector<char> rows,
+void ComplementaritySolver::polish_minimum_norm(const SparseMatrix& a, const Vector& c, std::vector<char> rows,
                                        const ComplementarityProblem& problem, Vector& p, SolverStats& stats) {
   for (std::size_t k = 0; k < rows.size(); ++k)  // rows at zero with w = 0 may share the impulse too
     if (!rows[k] && !problem.equality[k]) {
@@ -134,7 +120,7 @@ void IslandSolver::polish_minimum_norm(const SparseMatrix& a, const Vector& c, s
   if (members_f.size() < 2 || members_f.size() > settings_.polish_limit) return;
   SolverStats ignored;
   const SparseMatrix sub = principal_submatrix(a, members_f);
-  const Vector q = solve_dense_matrix(Eigen::MatrixXd(sub), gather(c, members_f), ignored);
+  const Vector q = equalities_.solve_dense_matrix(Eigen::MatrixXd(sub), gather(c, members_f), ignored);
   const double roundoff = kImpulseRoundoff * q.lpNorm<Eigen::Infinity>();
   for (std::size_t i = 0; i < members_f.size(); ++i)
     if (!problem.equality[members_f[i]] && q(static_cast<Eigen::Index>(i)) < -roundoff) return;

@@ -21,6 +21,10 @@
 
 namespace impetus {
 
+namespace ledas {
+struct Island;  // one island's working data (island.hpp)
+}  // namespace ledas
+
 /// Which contacts enter the system and how it is solved.
 enum class LedasMode : std::uint8_t {
   /// The paper's method (sec. 3.2) literally: only approaching contacts (v_n < −tolerance) enter;
@@ -119,17 +123,26 @@ class LedasResolver final : public CollisionResolver {
   const LedasStats& last_stats() const { return stats_; }
 
  private:
-  struct Island;
+  // The stages of one resolve(), each in its own file: ledas.cpp (rows, islands, report), island.cpp
+  // (an island's system), paper_rounds.cpp, complementary_impact.cpp, restitution.cpp,
+  // position_correction.cpp.
   void resolve_all(std::span<RigidBody> bodies, std::span<Contact> contacts, std::span<const Constraint> constraints,
                    const StepContext& ctx, ResolverCounters& counters);
-  Island make_island(std::vector<std::uint32_t> rows, std::span<const RigidBody> bodies, double dt);
-  const ledas::Vector& current_velocities(Island& island, std::span<const RigidBody> bodies) const;
-  void velocity_paper(Island& island, std::span<RigidBody> bodies, ResolverCounters& counters);
-  void velocity_complementary(Island& island, std::span<RigidBody> bodies, ResolverCounters& counters);
-  void narrow_start_set(const Island& island, const ledas::Vector& v, std::vector<char>& start);
-  bool retarget_joints(Island& island, const ledas::Vector& v, std::span<const RigidBody> bodies) const;
-  void finish_round(Island& island, const ledas::Vector& p, const ledas::Vector& target, std::span<RigidBody> bodies);
-  void correct_positions(Island& island, std::span<RigidBody> bodies);
+  void build_rows(std::span<const RigidBody> bodies, std::span<Contact> contacts,
+                  std::span<const Constraint> constraints, double dt, ResolverCounters& counters);
+  void solve_island(std::vector<std::uint32_t> rows, std::span<RigidBody> bodies, std::span<Contact> contacts,
+                    double dt, ResolverCounters& counters);
+  ledas::Island make_island(std::vector<std::uint32_t> rows, std::span<const RigidBody> bodies, double dt);
+  void assign_restitution(ledas::Island& island, std::span<const RigidBody> bodies);
+  const ledas::Vector& current_velocities(ledas::Island& island, std::span<const RigidBody> bodies) const;
+  void velocity_paper(ledas::Island& island, std::span<RigidBody> bodies, ResolverCounters& counters);
+  void velocity_complementary(ledas::Island& island, std::span<RigidBody> bodies, ResolverCounters& counters);
+  void narrow_start_set(const ledas::Island& island, const ledas::Vector& v, std::vector<char>& start);
+  void finish_round(ledas::Island& island, const ledas::Vector& p, const ledas::Vector& target,
+                    std::span<RigidBody> bodies);
+  void report_island(ledas::Island& island, std::span<const RigidBody> bodies, std::span<Contact> contacts,
+                     ResolverCounters& counters);
+  void correct_positions(ledas::Island& island, std::span<RigidBody> bodies);
 
   LedasSettings settings_;
   ledas::IslandSolver solver_;
