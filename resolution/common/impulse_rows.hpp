@@ -4,13 +4,13 @@
 /// matrix A = G M⁻¹ Gᵀ of the paper's eq. 6–7, the right-hand side of eq. 8, and applying impulses
 /// with eq. 3.
 ///
-/// Sign convention (shared/DESIGN.md): a row has bodies a, b, a world point P and a unit direction n
+/// Sign convention (docs/conventions.md): a row has bodies a, b, a world point P and a unit direction n
 /// (out of a into b). Its velocity is v_n = (u_b − u_a)·n with u = v + ω × r. An impulse magnitude p
 /// acts −p n on a and +p n on b, so for body s with sign σ (−1 for a, +1 for b):
 ///   Δv_s = σ p n / M_s,   Δω_s = σ p J_s⁻¹ (r_s × n)                          (eq. 3, sign fixed)
 /// and the rows' velocities change by A p with
 ///   A_ik = Σ_{s shared by rows i, k} σ_{s,i} σ_{s,k} [ n_i·n_k / M_s + (r_{s,i} × n_i)·J_s⁻¹ (r_{s,k} × n_k) ]
-/// (eq. 7 with its indices read as DESIGN.md says: symmetric positive semi-definite). The inelastic
+/// (eq. 7 with its indices read as docs/conventions.md says: symmetric positive semi-definite). The inelastic
 /// condition v_n⁺ = 0 (eq. 4) is A p = b with b = −v_n⁻ (eq. 8 with the sign fixed).
 /// Fixed bodies (inverse mass and inertia zero) drop out of every term.
 
@@ -49,8 +49,7 @@ class InverseInertiaCache {
   const Mat3& get(std::span<const RigidBody> bodies, BodyIndex index) {
     if (generation_of_[index] != generation_) {
       generation_of_[index] = generation_;
-      // Evaluated in place: copying a returned matrix in cost a failed store forwarding per body, a
-      // quarter of a row's set-up.
+      // Evaluated in place: copying a returned matrix in costs a failed store forwarding per body.
       bodies[index].inv_inertia_world(matrix_[index]);
     }
     return matrix_[index];

@@ -1,9 +1,9 @@
 #pragma once
 /// \file
-/// Resting contact, shared by every impulse resolver (issue: resolvers, item 3).
+/// Resting contact, shared by every impulse resolver.
 ///
-/// With the default split step (velocities → detect → resolve → positions; shared/DESIGN.md, "The
-/// step") a resting body does not sink: the resolver removes the approach that gravity added before
+/// With the default split step (velocities → detect → resolve → positions; docs/conventions.md,
+/// the step order) a resting body does not sink: the resolver removes the approach that gravity added before
 /// positions move. What remains is penetration that is already there (initial overlap, rounding,
 /// rotation of corners, the paper's step order). It is removed by a **position correction** that adds no
 /// kinetic energy: after the velocity solve, each resolver solves the same system once more for

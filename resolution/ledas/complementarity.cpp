@@ -17,14 +17,14 @@ namespace {
 constexpr double kJoinShare = 0.5;
 // After a free set that is not the answer, the search shift falls by this factor (to the final one).
 constexpr double kShiftReduction = 1e-3;
-// Conjugate-gradient steps of one refinement (pyramid K = 100: 6 in all, 19 without the sharper
-// preconditioner below; a chain: 1).
+// Conjugate-gradient steps of one refinement at most (a few suffice: the preconditioner is the
+// factorization of (A + εI)_FF).
 constexpr int kMaxRefinementSteps = 100;
 // The refinement's choice of preconditioner (refine_on_free_set): after kProbeSteps steps it predicts
 // the steps still needed from their mean reduction of the residual; when those would cost more than a
 // factorization at a smaller shift plus kStepsAfterSharpening steps, it refactors and restarts. A
 // factorization's multiply-adds are weighed kFactorizationWeight times a solve's (scattered updates and
-// short columns against streaming ones: measured 1–2 ns against 0.35–0.4 ns on the pyramids).
+// short columns against streaming ones).
 constexpr int kProbeSteps = 2;
 constexpr double kStepsAfterSharpening = 3.0;
 constexpr double kFactorizationWeight = 4.0;
@@ -179,11 +179,11 @@ struct ComplementaritySolver::Search {
 // released; a feasible one becomes p and the rows approaching fastest join), whose objective strictly
 // decreases between feasible minimizers, so it terminates.
 //
-// Two shifts. The first solve uses the final ε = regularization · max A_kk (1e-10): when the start set
-// is the answer (a line of spheres, a box on its face) that one solve is exact. Otherwise the search
-// goes on with ε = search_regularization · max A_kk (1e-3): with the tiny shift the subproblem is as
-// ill-conditioned as A itself and block pivoting stalls on redundant rows (pyramid K = 50: after four
-// exchanges, then 45 one-row primal steps); with the larger one it settles in a few exchanges. Each
+// Two shifts. The first solve uses the final ε = regularization · max A_kk: when the start set is the
+// answer (a line of spheres, a box on its face) that one solve is exact. Otherwise the search goes on
+// with ε = search_regularization · max A_kk: with the tiny shift the subproblem is as ill-conditioned
+// as A itself and block pivoting stalls on redundant rows, stepping one row at a time; with the larger
+// one it settles in a few exchanges. Each
 // solved subproblem's free set is then tried on the problem itself (refine_on_free_set: conjugate
 // gradients on A_FF p = c_F preconditioned by the factorization in hand); if that is not the answer, ε
 // falls by kShiftReduction towards the final one and the proximal iteration goes on from p.
@@ -340,42 +340,17 @@ ComplementaritySolver::Refinement ComplementaritySolver::refine_on_free_set(cons
                                                           const ComplementarityProblem& problem, Vector& x,
                                                           SolverStats& stats) {
   const auto m = free_rows.size();
-  // The preconditioner (A + εI)_FF⁻¹: the factorization if it is of F, else the last update if that
-  // solves for F, else a new factorization.
-  bool holds = loop.factored;
-  for (std::size_t k = 0; holds && k < m; ++k)
-    holds = free_rows[k] ? (loop.in_base[k] || loop.factor->dropped(k)) : !loop.in_base[k];
-  bool by_update = !holds && loop.factored && loop.update.solves_for(free_rows);
-  if (!holds && !by_update) factorize_loop(loop, a, free_rows, shift, stats);
+  bool by_update = prepare_preconditioner(a, shift, free_rows, loop, stats);
+  mark_solved_rows(free_rows, loop);
   Vector& residual = work_.residual;
   Vector& preconditioned = work_.preconditioned;
   Vector& direction = work_.direction;
   Vector& product = work_.product;
-  const auto precondition = [&](const Vector& v, Vector& out) {
-    if (by_update) {
-      loop.update.apply(*loop.factor, v, out);
-    } else {
-      out = v;
-      loop.factor->solve(out);
-    }
-  };
-  // F without the rows nothing movable is behind (left at p = 0, as the factorization leaves them).
-  std::vector<char>& solved_rows = work_.solved_rows;
-  solved_rows.resize(m);
-  for (std::size_t k = 0; k < m; ++k)
-    solved_rows[k] = free_rows[k] && work_.diagonal(static_cast<Eigen::Index>(k)) > loop.floor;
-  std::vector<Eigen::Index>& unsolved = work_.unsolved_rows;  // zeroed by index: no branch per row
-  unsolved.clear();
-  for (std::size_t k = 0; k < m; ++k)
-    if (!solved_rows[k]) unsolved.push_back(static_cast<Eigen::Index>(k));
-  const auto restrict_to_base = [&](Vector& v) {
-    for (const Eigen::Index k : unsolved) v(k) = 0.0;
-  };
-  restrict_to_base(x);
+  restrict_to_solved(x);
   residual.noalias() = -(a * x);
   residual += c;
-  restrict_to_base(residual);
-  precondition(residual, preconditioned);
+  restrict_to_solved(residual);
+  precondition(loop, by_update, residual, preconditioned);
   direction = preconditioned;
   double rz = residual.dot(preconditioned);
   const double scale = work_.diagonal.maxCoeff();
@@ -386,7 +361,7 @@ ComplementaritySolver::Refinement ComplementaritySolver::refine_on_free_set(cons
   double first_residual = 0.0;
   const double size_c = c.lpNorm<Eigen::Infinity>();
   bool solved = false;
-  for (int step = 0; step <= kMaxRefinementSteps; ++step) {
+  for (int step = 0; step <= kMaxRefinementSteps; ++step) {  // preconditioned conjugate gradients
     const double rounding = 1e-14 * (scale * x.lpNorm<Eigen::Infinity>() + size_c);
     const double goal = std::max(1e-3 * problem.tolerance, rounding);
     const double size = residual.lpNorm<Eigen::Infinity>();
@@ -396,45 +371,100 @@ ComplementaritySolver::Refinement ComplementaritySolver::refine_on_free_set(cons
     }
     if (step == kMaxRefinementSteps) break;
     if (step == 0) first_residual = size;
-    if (settings_.sharpen_refinement && step == kProbeSteps && shift > final_shift) {
-      // The preconditioned matrix has the eigenvalues λ/(λ + ε): many eigenvalues of A_FF below ε (a
-      // large, soft network: pyramid K = 100) make many steps. Predict them; if a factorization at a
-      // smaller shift is cheaper, take it and restart from x.
-      const double rate = std::pow(size / first_residual, 1.0 / kProbeSteps);
-      const double remaining = rate < 1.0 ? std::log(goal / size) / std::log(rate) : kMaxRefinementSteps;
-      if (remaining * step_cost >
-          kFactorizationWeight * loop.factor->factorization_work() + kStepsAfterSharpening * step_cost) {
-        shift = std::max(final_shift, kShiftReduction * shift);
-        factorize_loop(loop, a, free_rows, shift, stats);
-        loop.factored = false;  // at a shift the active-set loop is not using: refactor when it goes on
-        by_update = false;
-        ++stats.sharpened;
-        precondition(residual, preconditioned);
-        direction = preconditioned;
-        rz = residual.dot(preconditioned);
-      }
+    if (settings_.sharpen_refinement && step == kProbeSteps && shift > final_shift &&
+        sharpening_pays(size / first_residual, goal / size, step_cost, loop)) {
+      // Refactor at a smaller shift and restart from x.
+      shift = std::max(final_shift, kShiftReduction * shift);
+      factorize_loop(loop, a, free_rows, shift, stats);
+      loop.factored = false;  // at a shift the active-set loop is not using: refactor when it goes on
+      by_update = false;
+      ++stats.sharpened;
+      precondition(loop, by_update, residual, preconditioned);
+      direction = preconditioned;
+      rz = residual.dot(preconditioned);
     }
     ++stats.refinements;
     product.noalias() = a * direction;
-    restrict_to_base(product);
+    restrict_to_solved(product);
     const double curvature = direction.dot(product);
     if (!(curvature > 0.0)) break;
     const double alpha = rz / curvature;
     x += alpha * direction;
     residual -= alpha * product;
-    precondition(residual, preconditioned);
+    precondition(loop, by_update, residual, preconditioned);
     const double rz_next = residual.dot(preconditioned);
     direction = preconditioned + (rz_next / rz) * direction;
     rz = rz_next;
   }
   if (!solved) return Refinement::not_converged;
+  return accept_refined(a, c, problem, x);
+}
+
+// The refinement's preconditioner (A + εI)_FF⁻¹: the factorization if it is of F, else the last update
+// if that solves for F (returns true), else a new factorization.
+bool ComplementaritySolver::prepare_preconditioner(const SparseMatrix& a, double shift, const std::vector<char>& free_rows,
+                                                   ActiveLoop& loop, SolverStats& stats) {
+  bool holds = loop.factored;
+  for (std::size_t k = 0; holds && k < free_rows.size(); ++k)
+    holds = free_rows[k] ? (loop.in_base[k] || loop.factor->dropped(k)) : !loop.in_base[k];
+  const bool by_update = !holds && loop.factored && loop.update.solves_for(free_rows);
+  if (!holds && !by_update) factorize_loop(loop, a, free_rows, shift, stats);
+  return by_update;
+}
+
+// out = (A + εI)_FF⁻¹ v by the update or the factorization.
+void ComplementaritySolver::precondition(ActiveLoop& loop, bool by_update, const Vector& v, Vector& out) {
+  if (by_update) {
+    loop.update.apply(*loop.factor, v, out);
+  } else {
+    out = v;
+    loop.factor->solve(out);
+  }
+}
+
+// The rows solved for: F without the rows nothing movable is behind (left at p = 0, as the
+// factorization leaves them); the others listed, to be zeroed by index (no branch per row).
+void ComplementaritySolver::mark_solved_rows(const std::vector<char>& free_rows, const ActiveLoop& loop) {
+  const std::size_t m = free_rows.size();
+  std::vector<char>& solved_rows = work_.solved_rows;
+  solved_rows.resize(m);
+  for (std::size_t k = 0; k < m; ++k)
+    solved_rows[k] = free_rows[k] && work_.diagonal(static_cast<Eigen::Index>(k)) > loop.floor;
+  std::vector<Eigen::Index>& unsolved = work_.unsolved_rows;
+  unsolved.clear();
+  for (std::size_t k = 0; k < m; ++k)
+    if (!solved_rows[k]) unsolved.push_back(static_cast<Eigen::Index>(k));
+}
+
+void ComplementaritySolver::restrict_to_solved(Vector& v) const {
+  for (const Eigen::Index k : work_.unsolved_rows) v(k) = 0.0;
+}
+
+// The preconditioned matrix has the eigenvalues λ/(λ + ε): many eigenvalues of A_FF below ε (a large,
+// soft network) make many steps. After kProbeSteps steps that reduced the residual by `reduction` in
+// all, predicts the steps still needed to reduce it by `remaining`; whether a factorization at a
+// smaller shift plus kStepsAfterSharpening steps costs less.
+bool ComplementaritySolver::sharpening_pays(double reduction, double remaining, double step_cost,
+                                            const ActiveLoop& loop) const {
+  const double rate = std::pow(reduction, 1.0 / kProbeSteps);
+  const double steps = rate < 1.0 ? std::log(remaining) / std::log(rate) : kMaxRefinementSteps;
+  return steps * step_cost > kFactorizationWeight * loop.factor->factorization_work() + kStepsAfterSharpening * step_cost;
+}
+
+// A converged refinement is the answer if p ≥ 0 on the rows solved for and no other row approaches;
+// then the impulses are clamped at zero (rounding) on the inequality rows.
+ComplementaritySolver::Refinement ComplementaritySolver::accept_refined(const SparseMatrix& a, const Vector& c,
+                                                                        const ComplementarityProblem& problem,
+                                                                        Vector& x) {
+  const std::size_t m = work_.solved_rows.size();
+  Vector& product = work_.product;
   product.noalias() = a * x;
   product -= c;  // w
   const double roundoff = kImpulseRoundoff * x.lpNorm<Eigen::Infinity>();
   for (std::size_t k = 0; k < m; ++k) {
     if (problem.equality[k]) continue;
     const auto i = static_cast<Eigen::Index>(k);
-    if (solved_rows[k] ? x(i) < -roundoff : product(i) < -problem.tolerance) return Refinement::infeasible;
+    if (work_.solved_rows[k] ? x(i) < -roundoff : product(i) < -problem.tolerance) return Refinement::infeasible;
   }
   for (std::size_t k = 0; k < m; ++k)
     if (!problem.equality[k]) x(static_cast<Eigen::Index>(k)) = std::max(0.0, x(static_cast<Eigen::Index>(k)));

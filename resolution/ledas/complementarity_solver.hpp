@@ -41,6 +41,13 @@ class ComplementaritySolver {
                       ActiveLoop& loop, SolverStats& stats);
   Refinement refine_on_free_set(const SparseMatrix& a, const Vector& c, double shift, const std::vector<char>& free_rows,
                                 ActiveLoop& loop, const ComplementarityProblem& problem, Vector& x, SolverStats& stats);
+  bool prepare_preconditioner(const SparseMatrix& a, double shift, const std::vector<char>& free_rows, ActiveLoop& loop,
+                              SolverStats& stats);
+  static void precondition(ActiveLoop& loop, bool by_update, const Vector& v, Vector& out);
+  void mark_solved_rows(const std::vector<char>& free_rows, const ActiveLoop& loop);
+  void restrict_to_solved(Vector& v) const;
+  bool sharpening_pays(double reduction, double remaining, double step_cost, const ActiveLoop& loop) const;
+  Refinement accept_refined(const SparseMatrix& a, const Vector& c, const ComplementarityProblem& problem, Vector& x);
   Vector solve_min_norm(const ComplementarityProblem& problem, SolverStats& stats);
   void polish_minimum_norm(const SparseMatrix& a, const Vector& c, std::vector<char> rows,
                            const ComplementarityProblem& problem, Vector& p, SolverStats& stats);

@@ -58,8 +58,8 @@ void LedasResolver::velocity_complementary(ledas::Island& island, std::span<Rigi
 // same distance runs across the front along which the impact travels: the bodies behind a front are
 // pushed apart along it, not together (a pyramid's horizontal contacts, boxes side by side on a floor),
 // so such a contact almost always separates. Started in, it is a redundant row the first solve must
-// factorize and the search must then release (pyramid K = 20: 190 of 590 rows, and most of the
-// factorization's fill); left out, it joins at the next iteration if it would approach. Contacts with a
+// factorize (a pyramid's horizontal contacts carry most of the factorization's fill) and the search
+// must then release; left out, it joins at the next iteration if it would approach. Contacts with a
 // fixed body and contacts between bodies the impact does not reach keep their places (in; out: nothing
 // pushes them).
 void LedasResolver::narrow_start_set(const ledas::Island& island, const Vector& v, std::vector<char>& start) {

@@ -11,7 +11,7 @@
 ///
 /// Levels (ConstraintLevel):
 ///  - velocity: target v_n⁺ = 0 along each row (the paper's first scheme; the points drift apart);
-///  - position: eqs. 9–10 as shared/DESIGN.md reads them: the points coincide after the step. To first
+///  - position: eqs. 9–10 read as docs/conventions.md reads them: the points coincide after the step. To first
 ///    order, s + dt·v_n⁺ = 0 with s the current separation along the row, i.e. target v_n⁺ = −s/dt.
 ///    The row uses the exact prediction instead: s⁺ = the separation after a step at the current
 ///    velocities, the bodies moved as eq. 2 moves them (x += dt v, R = Q(ω dt) R), and target

@@ -5,8 +5,7 @@
 /// A = G M⁻¹ Gᵀ) and a right-hand side come in, impulses come out, so it is tested directly.
 ///
 /// Equalities on a subset (the paper mode's rounds): the subset splits into independent blocks (rows
-/// coupled through a shared movable body), each solved by the cheapest exact method (shared/DESIGN.md,
-/// "Model no more than a scene needs"):
+/// coupled through a shared movable body), each solved by the cheapest exact method:
 ///  - one row: closed form p = c / A_11;
 ///  - up to `dense_limit` rows: dense LDLᵀ with diagonal pivoting (rank-revealing for a PSD matrix);
 ///  - more rows: sparse LDLᵀ (Eigen SimplicialLDLT, AMD ordering; symbolic analysis cached by pattern);

@@ -1,6 +1,6 @@
 #pragma once
 /// \file
-/// The LEDAS simultaneous impulse resolver (Ermolin & Kazakov, shared/papers/ledas-simultaneous-impulses.md).
+/// The LEDAS simultaneous impulse resolver: Ermolin & Kazakov (LEDAS), simultaneous impulse method.
 /// README.md derives A and b with their signs, lists the paper's typos as fixed, and says what the
 /// method assumes, guarantees and where it fails.
 ///

@@ -15,10 +15,10 @@ using resolution::ImpulseRow;
 
 namespace {
 
-// The rows' velocities through the rounds. The rounds are many (line N = 100: ~10⁵), so a row's velocity
-// is re-evaluated only when a round moved one of its bodies, as the Jacobian product
-// v_n = n·(v_b − v_a) + (r_b×n)·ω_b − (r_a×n)·ω_a (eq. 5 with (ω×r)·n = ω·(r×n)), the fixed bodies'
-// share computed once.
+// The rows' velocities through the rounds. The rounds are many (an inelastic line of N bodies: about
+// 10 N²), so a row's velocity is re-evaluated only when a round moved one of its bodies, as the
+// Jacobian product v_n = n·(v_b − v_a) + (r_b×n)·ω_b − (r_a×n)·ω_a (eq. 5 with (ω×r)·n = ω·(r×n)),
+// the fixed bodies' share computed once.
 class RoundVelocities {
  public:
   RoundVelocities(const ledas::Island& island, std::span<const ImpulseRow> rows, std::span<const RigidBody> bodies)
