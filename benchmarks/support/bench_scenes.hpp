@@ -7,7 +7,7 @@
 
 #include "fcl/fcl_detector.hpp"
 #include "impetus/core/generators.hpp"
-#include "common/impulse_rows.hpp"
+#include "impetus/resolution/common/impulse_rows.hpp"
 
 #include <algorithm>
 #include <cmath>

@@ -1,4 +1,4 @@
-#include "common/incidence.hpp"
+#include "impetus/resolution/common/incidence.hpp"
 
 namespace impetus::resolution {
 

@@ -1,6 +1,6 @@
 // The bordered (Schur-complement) update of a masked factorization; bordered_update.hpp derives it.
-#include "ledas/bordered_update.hpp"
-#include "ledas/masked_ldlt.hpp"
+#include "bordered_update.hpp"
+#include "impetus/resolution/ledas/masked_ldlt.hpp"
 
 #include <algorithm>
 #include <cmath>

@@ -14,7 +14,7 @@
 /// is (the changes of an active-set search mostly grow), and one right-hand side costs one solve split
 /// in halves: t = L⁻¹ P c, y from Wᵀ D⁻¹ t, then p_B = Pᵀ L⁻ᵀ D⁻¹ (t − W y).
 
-#include "ledas/island_solver.hpp"
+#include "impetus/resolution/ledas/island_solver.hpp"
 
 #include <Eigen/Dense>
 

@@ -1,10 +1,10 @@
 // Complementarity problems (the complementary mode's impact, the position correction): the proximal
 // active set on the masked factorization, with Schur-complement updates and an exact refinement of
 // each candidate free set. README.md, "Complementary mode and position correction", derives it.
-#include "ledas/complementarity_solver.hpp"
-#include "ledas/masked_ldlt.hpp"
-#include "ledas/primal_step.hpp"
-#include "ledas/solver_internal.hpp"
+#include "complementarity_solver.hpp"
+#include "impetus/resolution/ledas/masked_ldlt.hpp"
+#include "primal_step.hpp"
+#include "solver_internal.hpp"
 
 #include <algorithm>
 #include <cmath>

@@ -1,9 +1,9 @@
 // Complementarity problems: the two minimum-norm pieces around the proximal active set of
 // complementarity.cpp — the fallback for problems without an exact solution, and the minimum-norm
 // impulse split of a small final system.
-#include "ledas/complementarity_solver.hpp"
-#include "ledas/primal_step.hpp"
-#include "ledas/solver_internal.hpp"
+#include "complementarity_solver.hpp"
+#include "primal_step.hpp"
+#include "solver_internal.hpp"
 
 #include <algorithm>
 #include <cmath>

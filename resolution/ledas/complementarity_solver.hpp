@@ -4,8 +4,8 @@
 /// factorization (complementarity.cpp), its exact refinement of a candidate free set, and the two
 /// minimum-norm pieces around it (complementarity_fallback.cpp).
 
-#include "ledas/equality_solver.hpp"
-#include "ledas/island_solver.hpp"
+#include "equality_solver.hpp"
+#include "impetus/resolution/ledas/island_solver.hpp"
 
 #include <cstdint>
 #include <memory>

@@ -1,7 +1,7 @@
 // The complementary mode: each round solves the exact inelastic impact (a linear complementarity
 // problem over the approaching and touching rows, island_solver.hpp), then applies (1 + e) p.
-#include "ledas/island.hpp"
-#include "ledas/ledas.hpp"
+#include "island.hpp"
+#include "impetus/resolution/ledas/ledas.hpp"
 
 #include <cmath>
 

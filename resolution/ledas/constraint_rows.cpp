@@ -1,4 +1,4 @@
-#include "ledas/constraint_rows.hpp"
+#include "impetus/resolution/ledas/constraint_rows.hpp"
 
 #include <algorithm>
 #include <cmath>

@@ -1,8 +1,8 @@
 // The paper mode's rounds (sec. 3.2): eq. 6, A_SS p = c_S, as equalities on a subset of an island's
 // rows, each independent block by the cheapest exact method (island_solver.hpp), the minimum-norm
 // least-squares solution where a block is rank-deficient (the paper's Figure 2 and its SVD remark).
-#include "ledas/equality_solver.hpp"
-#include "ledas/solver_internal.hpp"
+#include "equality_solver.hpp"
+#include "solver_internal.hpp"
 
 #include <Eigen/SparseCholesky>
 

@@ -5,7 +5,7 @@
 /// mode's rounds call it through IslandSolver::solve_subset; the complementarity fallback and polish call
 /// solve_system and solve_dense_matrix.
 
-#include "ledas/island_solver.hpp"
+#include "impetus/resolution/ledas/island_solver.hpp"
 
 #include <Eigen/Dense>
 

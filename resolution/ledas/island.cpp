@@ -1,7 +1,7 @@
 // Building an island's system: its movable bodies and their incidence, A of eq. 7, each row's target;
 // the rows' velocities; the position-level joints' targets.
-#include "ledas/island.hpp"
-#include "ledas/ledas.hpp"
+#include "island.hpp"
+#include "impetus/resolution/ledas/ledas.hpp"
 
 #include <algorithm>
 #include <cmath>

@@ -1,9 +1,9 @@
 // The island solver: the two solvers it joins (equality_solver.hpp, complementarity_solver.hpp) and
 // principal submatrices.
-#include "ledas/island_solver.hpp"
-#include "ledas/complementarity_solver.hpp"
-#include "ledas/equality_solver.hpp"
-#include "ledas/solver_internal.hpp"
+#include "impetus/resolution/ledas/island_solver.hpp"
+#include "complementarity_solver.hpp"
+#include "equality_solver.hpp"
+#include "solver_internal.hpp"
 
 #include <algorithm>
 

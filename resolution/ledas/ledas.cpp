@@ -1,8 +1,8 @@
 // The LEDAS resolver's step: rows from contacts and constraints, islands, and per island the velocity
 // phase (paper_rounds.cpp or complementary_impact.cpp), the report into the contacts and counters, and the
 // position correction (position_correction.cpp).
-#include "ledas/island.hpp"
-#include "ledas/ledas.hpp"
+#include "island.hpp"
+#include "impetus/resolution/ledas/ledas.hpp"
 
 #include <algorithm>
 #include <cmath>

@@ -1,4 +1,4 @@
-#include "ledas/masked_ldlt.hpp"
+#include "impetus/resolution/ledas/masked_ldlt.hpp"
 
 #include <Eigen/OrderingMethods>
 

@@ -1,7 +1,7 @@
 // The paper mode (sec. 3.2): rounds in which only the approaching rows enter, A_SS p = b_S is solved as
 // equalities, (1 + e) p applied, and every row re-checked, until none approaches.
-#include "ledas/island.hpp"
-#include "ledas/ledas.hpp"
+#include "island.hpp"
+#include "impetus/resolution/ledas/ledas.hpp"
 
 #include <algorithm>
 #include <cmath>

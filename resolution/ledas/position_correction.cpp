@@ -1,8 +1,8 @@
-// The position correction after the velocity phase (resolution/common/resting.hpp): pseudo-impulses
+// The position correction after the velocity phase (impetus/resolution/common/resting.hpp): pseudo-impulses
 // q ≥ 0 with A q ≥ target and complementarity move positions only.
-#include "common/resting.hpp"
-#include "ledas/island.hpp"
-#include "ledas/ledas.hpp"
+#include "impetus/resolution/common/resting.hpp"
+#include "island.hpp"
+#include "impetus/resolution/ledas/ledas.hpp"
 
 namespace impetus {
 

@@ -1,6 +1,6 @@
 // The primal active-set step (primal_step.hpp): one definition for the proximal search and the fallback.
-#include "ledas/primal_step.hpp"
-#include "ledas/solver_internal.hpp"
+#include "primal_step.hpp"
+#include "solver_internal.hpp"
 
 #include <algorithm>
 

@@ -5,7 +5,7 @@
 /// test along a direction, the move, the release of the rows that reached zero, and the final clamp of
 /// the impulses to the free set.
 
-#include "ledas/island_solver.hpp"
+#include "impetus/resolution/ledas/island_solver.hpp"
 
 #include <cstddef>
 #include <vector>

@@ -1,15 +1,15 @@
 // Restitution (sec. 3.2, end): the inelastic impulses p, then the restitution phase e p, for a total of
 // (1 + e) p; each row's e, with the bounce threshold judged per island.
-#include "common/resting.hpp"
-#include "ledas/island.hpp"
-#include "ledas/ledas.hpp"
+#include "impetus/resolution/common/resting.hpp"
+#include "island.hpp"
+#include "impetus/resolution/ledas/ledas.hpp"
 
 #include <algorithm>
 
 namespace impetus {
 
 // Restitution per island: the bounce threshold is judged on the island's fastest approach, because
-// touching contacts carry the restitution phase too (resolution/common/resting.hpp).
+// touching contacts carry the restitution phase too (impetus/resolution/common/resting.hpp).
 void LedasResolver::assign_restitution(ledas::Island& island, std::span<const RigidBody> bodies) {
   const std::size_t m = island.rows.size();
   const ledas::Vector& v = current_velocities(island, bodies);

@@ -4,10 +4,10 @@
 /// complementarity_fallback.cpp, primal_step.cpp): the active-set loop's state and small helpers. Not
 /// installed, not for tests.
 
-#include "ledas/bordered_update.hpp"
-#include "ledas/complementarity_solver.hpp"
-#include "ledas/island_solver.hpp"
-#include "ledas/masked_ldlt.hpp"
+#include "bordered_update.hpp"
+#include "complementarity_solver.hpp"
+#include "impetus/resolution/ledas/island_solver.hpp"
+#include "impetus/resolution/ledas/masked_ldlt.hpp"
 
 #include <memory>
 #include <span>

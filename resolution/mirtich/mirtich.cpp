@@ -1,6 +1,6 @@
-#include "mirtich/mirtich.hpp"
+#include "impetus/resolution/mirtich/mirtich.hpp"
 
-#include "common/incidence.hpp"
+#include "impetus/resolution/common/incidence.hpp"
 
 #include <algorithm>
 #include <cmath>

@@ -19,7 +19,7 @@
 ///    curvature (½ (ω dt)² r per step) leaves with the first-order form. Eq. 9's factor dt multiplies
 ///    a whole row of A and b and is divided out, keeping A symmetric.
 
-#include "common/impulse_rows.hpp"
+#include "impetus/resolution/common/impulse_rows.hpp"
 #include "impetus/modules/constraint.hpp"
 
 #include <cstdint>

@@ -4,17 +4,17 @@
 /// README.md derives A and b with their signs, lists the paper's typos as fixed, and says what the
 /// method assumes, guarantees and where it fails.
 ///
-/// Notation (resolution/common/impulse_rows.hpp): row k (a contact or a joint direction) has
+/// Notation (impetus/resolution/common/impulse_rows.hpp): row k (a contact or a joint direction) has
 /// v_k = (u_b − u_a)·n_k (< 0 approaches); impulses p act −p n on a and +p n on b (eq. 3, sign fixed);
 /// the rows' velocities change by A p with A = G M⁻¹ Gᵀ (eq. 7), and eq. 4's inelastic condition is
 /// A p = b with b = target − v⁻ (eq. 8 with its sign fixed; target = 0 for a touching contact).
 
-#include "common/impulse_rows.hpp"
-#include "common/resting.hpp"
+#include "impetus/resolution/common/impulse_rows.hpp"
+#include "impetus/resolution/common/resting.hpp"
 #include "impetus/modules/options.hpp"
 #include "impetus/modules/resolver.hpp"
-#include "ledas/constraint_rows.hpp"
-#include "ledas/island_solver.hpp"
+#include "impetus/resolution/ledas/constraint_rows.hpp"
+#include "impetus/resolution/ledas/island_solver.hpp"
 
 #include <cstdint>
 #include <vector>
@@ -66,7 +66,7 @@ struct LedasSettings {
   /// one system (`islands: false`: the same velocities up to rounding, with the bounce threshold judged
   /// over all rows; only slower or faster, as benchmarks/model.cpp measures).
   bool islands = true;
-  /// Options `slop`, `correction`, `bounce_threshold` (resolution/common/resting.hpp).
+  /// Options `slop`, `correction`, `bounce_threshold` (impetus/resolution/common/resting.hpp).
   resolution::RestingSettings resting;
 
   /// Reads every option above; throws OptionError for a bad value.

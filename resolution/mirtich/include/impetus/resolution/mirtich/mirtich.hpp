@@ -5,14 +5,14 @@
 /// argues against it with Figure 1 and the "almost freezing" stacks). See README.md for what it
 /// assumes, guarantees and where it fails.
 ///
-/// Notation (shared with resolution/common/impulse_rows.hpp): a contact k is a row with relative normal
+/// Notation (shared with impetus/resolution/common/impulse_rows.hpp): a contact k is a row with relative normal
 /// velocity v_k = (u_b − u_a)·n_k (< 0 approaches) and A_kk = 1/m_eff (eq. 7 for i = k). Its single
 /// impulse is
 ///   p_k = −(1 + e_k) v_k / A_kk,
 /// which leaves v_k⁺ = −e_k v_k exactly (the paper's eq. 6 for m = 1, with the restitution of sec. 3.2).
 
-#include "common/impulse_rows.hpp"
-#include "common/resting.hpp"
+#include "impetus/resolution/common/impulse_rows.hpp"
+#include "impetus/resolution/common/resting.hpp"
 #include "impetus/modules/options.hpp"
 #include "impetus/modules/resolver.hpp"
 

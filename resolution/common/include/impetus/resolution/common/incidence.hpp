@@ -5,7 +5,7 @@
 /// body), the paper mode's stale-row tracking, the complementary mode's start set and the sequential
 /// resolver's refresh of v_n all read it.
 
-#include "common/impulse_rows.hpp"
+#include "impetus/resolution/common/impulse_rows.hpp"
 
 #include <array>
 #include <cstdint>
