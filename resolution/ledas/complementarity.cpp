@@ -335,6 +335,8 @@ void ComplementaritySolver::settle(Search& s, SolverStats& stats) {
 // (redundant rows in F); c_F is then in its range (contacts: c = −G v⁻), the iterates stay in the
 // range, and the result is the solution nearest to the start. Stops at |A_FF p_F − c_F| ≤ 1e-3 ·
 // tolerance (or rounding), as the proximal iteration does.
+// The conjugate-gradient recurrence is kept in one function (about 60 lines): split, its state (x, the
+// residual, the direction, rz) would have to travel between the pieces.
 ComplementaritySolver::Refinement ComplementaritySolver::refine_on_free_set(const SparseMatrix& a, const Vector& c, double shift,
                                                           const std::vector<char>& free_rows, ActiveLoop& loop,
                                                           const ComplementarityProblem& problem, Vector& x,

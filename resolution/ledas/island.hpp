@@ -4,9 +4,9 @@
 /// (local row i is the resolver's row rows[i]), A of eq. 7 over them, targets, restitution and the
 /// impulses accumulated over the rounds.
 
+#include "impetus/core/body.hpp"
 #include "impetus/resolution/common/impulse_rows.hpp"
 #include "impetus/resolution/common/incidence.hpp"
-#include "impetus/core/body.hpp"
 #include "impetus/resolution/ledas/constraint_rows.hpp"
 #include "impetus/resolution/ledas/island_solver.hpp"
 

@@ -17,8 +17,8 @@
 /// gets e = 0. It is judged per island, not per contact, because in a simultaneous impact touching
 /// contacts (v_n = 0) carry the restitution phase too (Newton's cradle: (1 + e) p on every contact).
 
-#include "impetus/resolution/common/impulse_rows.hpp"
 #include "impetus/modules/options.hpp"
+#include "impetus/resolution/common/impulse_rows.hpp"
 
 #include <algorithm>
 

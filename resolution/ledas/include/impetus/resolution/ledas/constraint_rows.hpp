@@ -19,8 +19,8 @@
 ///    curvature (½ (ω dt)² r per step) leaves with the first-order form. Eq. 9's factor dt multiplies
 ///    a whole row of A and b and is divided out, keeping A symmetric.
 
-#include "impetus/resolution/common/impulse_rows.hpp"
 #include "impetus/modules/constraint.hpp"
+#include "impetus/resolution/common/impulse_rows.hpp"
 
 #include <cstdint>
 #include <span>

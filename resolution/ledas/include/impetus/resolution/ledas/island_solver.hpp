@@ -23,8 +23,9 @@
 ///
 /// Sources: equality_solver.cpp (the paper mode's subsets), complementarity.cpp (the proximal active
 /// set), complementarity_fallback.cpp (minimum-norm fallback and polish), primal_step.cpp,
-/// bordered_update.cpp, masked_ldlt.cpp. No minimum-norm solve inside the loop (the velocities are unique,
-/// the impulses are not); a minimum-norm polish at the end where the system is small. README.md derives it.
+/// bordered_update.cpp, masked_ldlt.cpp. No minimum-norm solve inside the loop (the velocities are
+/// unique, the impulses are not); a minimum-norm polish at the end where the system is small.
+/// resolution/ledas/README.md derives it.
 
 #include <Eigen/Dense>
 #include <Eigen/SparseCholesky>
@@ -124,8 +125,8 @@ class IslandSolver {
   void solve_subset(const SparseMatrix& a, const Vector& c, std::span<const RowIndex> subset, Vector& p,
                     SolverStats& stats);
 
-  /// Solves the complementarity problem (complementarity.cpp, README.md): proximal-point outer iterations
-  /// on ½ pᵀ(A + εI) p − (c + ε p̄)ᵀp, ε = regularization · max A_kk for the first solve and
+  /// Solves the complementarity problem (complementarity.cpp, resolution/ledas/README.md): proximal-point
+  /// outer iterations on ½ pᵀ(A + εI) p − (c + ε p̄)ᵀp, ε = regularization · max A_kk for the first solve and
   /// search_regularization · max A_kk while the active set is searched, each subproblem by block
   /// principal pivoting while the number of infeasible rows falls, then the primal active-set method
   /// (monotone: it terminates), started from the given set; each solved subproblem's free set F is tried

@@ -1,18 +1,18 @@
 #pragma once
 /// \file
 /// The LEDAS simultaneous impulse resolver: Ermolin & Kazakov (LEDAS), simultaneous impulse method.
-/// README.md derives A and b with their signs, lists the paper's typos as fixed, and says what the
-/// method assumes, guarantees and where it fails.
+/// resolution/ledas/README.md derives A and b with their signs, lists the paper's typos as fixed, and
+/// says what the method assumes, guarantees and where it fails.
 ///
 /// Notation (impetus/resolution/common/impulse_rows.hpp): row k (a contact or a joint direction) has
 /// v_k = (u_b − u_a)·n_k (< 0 approaches); impulses p act −p n on a and +p n on b (eq. 3, sign fixed);
 /// the rows' velocities change by A p with A = G M⁻¹ Gᵀ (eq. 7), and eq. 4's inelastic condition is
 /// A p = b with b = target − v⁻ (eq. 8 with its sign fixed; target = 0 for a touching contact).
 
-#include "impetus/resolution/common/impulse_rows.hpp"
-#include "impetus/resolution/common/resting.hpp"
 #include "impetus/modules/options.hpp"
 #include "impetus/modules/resolver.hpp"
+#include "impetus/resolution/common/impulse_rows.hpp"
+#include "impetus/resolution/common/resting.hpp"
 #include "impetus/resolution/ledas/constraint_rows.hpp"
 #include "impetus/resolution/ledas/island_solver.hpp"
 
@@ -37,8 +37,9 @@ enum class LedasMode : std::uint8_t {
   complementary
 };
 
-/// Which touching contacts the complementary mode's active-set search starts with (README.md, "The
-/// start set"). Only the first guess of the active set: the answer is the same either way.
+/// Which touching contacts the complementary mode's active-set search starts with
+/// (resolution/ledas/README.md, "The start set"). Only the first guess of the active set: the answer is
+/// the same either way.
 enum class LedasStartSet : std::uint8_t {
   /// Approaching contacts, and the touching ones that can pass the impact on: to a fixed body, or
   /// between two bodies at different distances (contact hops) from the impact. A touching contact across

@@ -102,7 +102,7 @@ class MaskedLdlt {
   /// outside the factorization are ignored): w = L⁻¹ P u as its non-zeros (elimination order,
   /// increasing). It visits only the elimination-tree ancestors of u's rows (every entry L_ij lies on
   /// the path from j to the root), about the tree's height in columns instead of all of them.
-  void forward_sparse(std::span<const std::pair<int, double>> u, std::vector<int>& index,
+  void forward_sparse(std::span<const std::pair<SparseIndex, double>> u, std::vector<SparseIndex>& index,
                       std::vector<double>& value) const;
   /// 1/d_i of row i in elimination order: 0 off the factorization and on dropped rows.
   double pivot_inverse(SparseIndex i) const { return d_inverse_[i]; }
@@ -121,6 +121,12 @@ class MaskedLdlt {
  private:
   static constexpr char kOff = 0, kOn = 1, kDropped = 2;
   static IndexVector<SparseIndex> minimum_degree(const Matrix& a);
+  // The steps of analyze(): order_ and new_of_old_; the upper triangle of P A Pᵀ; the elimination tree,
+  // column counts and column starts of L; the pattern of each row of L.
+  void order_rows(const Matrix& a);
+  void upper_triangle();
+  void elimination_tree();
+  void row_patterns();
 
   IndexVector<SparseIndex> outer_, inner_;       // the pattern of A
   IndexVector<char> analysed_;                   // per row: in the analysed pattern (may be in F)
