@@ -4,8 +4,8 @@
 /// "ledas_paper" (the paper's rounds) and "mirtich" (sequential). One place, so `resolve`, `step` and
 /// `peers` run them with identical settings.
 
-#include "ledas/ledas.hpp"
-#include "mirtich/mirtich.hpp"
+#include "impetus/resolution/ledas/ledas.hpp"
+#include "impetus/resolution/mirtich/mirtich.hpp"
 
 #include <memory>
 #include <string>

@@ -7,7 +7,7 @@
 
 #include "impetus/detection/fcl/fcl_detector.hpp"
 #include "impetus/engine/generators.hpp"
-#include "common/impulse_rows.hpp"
+#include "impetus/resolution/common/impulse_rows.hpp"
 
 #include <algorithm>
 #include <cmath>

@@ -1,4 +1,4 @@
-#include "common/impulse_rows.hpp"
+#include "impetus/resolution/common/impulse_rows.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -13,10 +13,11 @@ void InverseInertiaCache::reset(std::size_t body_count) {
 }
 
 namespace {
-// make_row with J⁻¹ of a body from `inv_inertia(body index)`.
+// make_row with J⁻¹ of a body from `inv_inertia(body index)`; the impulse acts at `point` on a and
+// `point_b` on b.
 template <class InverseInertia>
 ImpulseRow row_from(std::span<const RigidBody> bodies, InverseInertia&& inv_inertia, BodyIndex ia, BodyIndex ib,
-                    const Vec3& point, const Vec3& normal, double restitution) {
+                    const Vec3& point, const Vec3& point_b, const Vec3& normal, double restitution) {
   const RigidBody& a = bodies[ia];
   const RigidBody& b = bodies[ib];
   ImpulseRow row;
@@ -24,6 +25,7 @@ ImpulseRow row_from(std::span<const RigidBody> bodies, InverseInertia&& inv_iner
   row.b = ib;
   row.normal = normal;
   row.point = point;
+  row.point_b = point_b;
   row.restitution = restitution;
   if (!a.fixed) {
     row.inv_mass_a = a.inv_mass;
@@ -32,7 +34,7 @@ ImpulseRow row_from(std::span<const RigidBody> bodies, InverseInertia&& inv_iner
   }
   if (!b.fixed) {
     row.inv_mass_b = b.inv_mass;
-    row.arm_b = (point - b.position).cross(normal);
+    row.arm_b = (point_b - b.position).cross(normal);
     row.turn_b = inv_inertia(ib) * row.arm_b;
   }
   return row;
@@ -42,13 +44,19 @@ ImpulseRow row_from(std::span<const RigidBody> bodies, InverseInertia&& inv_iner
 ImpulseRow make_row(std::span<const RigidBody> bodies, BodyIndex ia, BodyIndex ib, const Vec3& point,
                     const Vec3& normal, double restitution) {
   return row_from(
-      bodies, [&](BodyIndex i) { return bodies[i].inv_inertia_world(); }, ia, ib, point, normal, restitution);
+      bodies, [&](BodyIndex i) { return bodies[i].inv_inertia_world(); }, ia, ib, point, point, normal, restitution);
 }
 
 ImpulseRow make_row(std::span<const RigidBody> bodies, InverseInertiaCache& inertia, BodyIndex ia, BodyIndex ib,
                     const Vec3& point, const Vec3& normal, double restitution) {
   return row_from(
-      bodies, [&](BodyIndex i) -> const Mat3& { return inertia.get(bodies, i); }, ia, ib, point, normal, restitution);
+      bodies, [&](BodyIndex i) -> const Mat3& { return inertia.get(bodies, i); }, ia, ib, point, point, normal, restitution);
+}
+
+ImpulseRow make_row(std::span<const RigidBody> bodies, InverseInertiaCache& inertia, BodyIndex ia, BodyIndex ib,
+                    const Vec3& point_a, const Vec3& point_b, const Vec3& normal) {
+  return row_from(
+      bodies, [&](BodyIndex i) -> const Mat3& { return inertia.get(bodies, i); }, ia, ib, point_a, point_b, normal, 0.0);
 }
 
 ImpulseRow make_contact_row(std::span<const RigidBody> bodies, const Contact& contact) {

@@ -1,4 +1,4 @@
-#include "common/resting.hpp"
+#include "impetus/resolution/common/resting.hpp"
 
 namespace impetus::resolution {
 

@@ -1,8 +1,9 @@
 // Complementarity problems: the two minimum-norm pieces around the proximal active set of
 // complementarity.cpp — the fallback for problems without an exact solution, and the minimum-norm
 // impulse split of a small final system.
-#include "ledas/island_solver.hpp"
-#include "ledas/solver_internal.hpp"
+#include "complementarity_solver.hpp"
+#include "primal_step.hpp"
+#include "solver_internal.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -10,15 +11,74 @@
 
 namespace impetus::ledas {
 
+namespace {
+
+// z = the minimum-norm least-squares solution of A_FF z_F = c_F on the free rows F, zero off F.
+Vector min_norm_on_free_set(EqualitySolver& equalities, const SparseMatrix& a, const Vector& c,
+                            const std::vector<char>& free_rows, SolverStats& stats) {
+  const std::vector<RowIndex> rows = members(free_rows);
+  Vector z = Vector::Zero(a.rows());
+  const Vector part = equalities.solve_system(principal_submatrix(a, rows), gather(c, rows), stats);
+  for (std::size_t i = 0; i < rows.size(); ++i) z(rows[i]) = part(static_cast<Eigen::Index>(i));
+  return z;
+}
+
+// A singular system with an inconsistent right-hand side has no minimizer on F: the objective falls
+// without bound along the residual d = c − A z (a null direction). Sets d to its clear components on F
+// and returns whether it is such a direction for some inequality row (else z is the answer on F).
+bool null_direction(const ComplementarityProblem& problem, const Vector& z, const std::vector<char>& free_rows,
+                    bool singular, Vector& d) {
+  const Vector& c = problem.rhs;
+  d = c - *problem.matrix * z;
+  double inconsistency = 0.0;
+  for (std::size_t k = 0; k < free_rows.size(); ++k)
+    if (free_rows[k]) inconsistency = std::max(inconsistency, std::abs(d(static_cast<Eigen::Index>(k))));
+    else d(static_cast<Eigen::Index>(k)) = 0.0;
+  if (!(singular && inconsistency > 0.5 * problem.tolerance)) return false;
+  bool along_null = false;
+  for (std::size_t k = 0; k < free_rows.size(); ++k) {
+    double& dk = d(static_cast<Eigen::Index>(k));
+    if (std::abs(dk) < 1e-6 * inconsistency) dk = 0.0;
+    along_null = along_null || (!problem.equality[k] && dk != 0.0);
+  }
+  return along_null;
+}
+
+// Whether z is ≥ 0 (to rounding) on every free inequality row.
+bool feasible(const Vector& z, const std::vector<char>& free_rows, const std::vector<char>& equality, double roundoff) {
+  bool out = true;
+  for (std::size_t k = 0; k < free_rows.size(); ++k)
+    if (free_rows[k] && !equality[k] && z(static_cast<Eigen::Index>(k)) < -roundoff) out = false;
+  return out;
+}
+
+// At a feasible p: clamps rounding below zero on the free rows and adds every row at zero that would
+// approach (w < −tolerance). Returns whether any row was added.
+bool add_approaching(const ComplementarityProblem& problem, Vector& p, std::vector<char>& free_rows,
+                     SolverStats& stats) {
+  const Vector w = *problem.matrix * p - problem.rhs;
+  bool added = false;
+  for (std::size_t k = 0; k < free_rows.size(); ++k) {
+    const auto i = static_cast<Eigen::Index>(k);
+    if (!problem.equality[k] && free_rows[k]) p(i) = std::max(p(i), 0.0);  // rounding below zero
+    if (!free_rows[k] && w(i) < -problem.tolerance) {
+      free_rows[k] = 1;
+      added = true;
+      ++stats.added;
+    }
+  }
+  return added;
+}
+
+}  // namespace
+
 // The earlier method, kept as the fallback for problems the proximal iteration cannot finish (an
 // inconsistent singular system: conflicting targets, where the regularized iterates drift): each free
 // set solved by minimum-norm least squares, whose residual is then a null direction followed to the
-// first bound.
-Vector IslandSolver::solve_complementarity_min_norm(const ComplementarityProblem& problem, SolverStats& stats) {
+// first bound; the primal active-set step (primal_step.hpp) otherwise.
+Vector ComplementaritySolver::solve_min_norm(const ComplementarityProblem& problem, SolverStats& stats) {
   const SparseMatrix& a = *problem.matrix;
   const auto m = static_cast<std::size_t>(a.rows());
-  const Vector& c = problem.rhs;
-  const auto inequality = [&](std::size_t k) { return !problem.equality[k]; };
   std::vector<char> free_rows(m);
   for (std::size_t k = 0; k < m; ++k) free_rows[k] = problem.equality[k] || problem.start[k];
   Vector p = Vector::Zero(a.rows());
@@ -26,95 +86,42 @@ Vector IslandSolver::solve_complementarity_min_norm(const ComplementarityProblem
   for (std::uint64_t iteration = 0; iteration < settings_.max_iterations; ++iteration) {
     ++stats.iterations;
     const std::uint64_t singular_before = stats.singular;
-    const std::vector<RowIndex> rows = members(free_rows);
-    Vector z = Vector::Zero(a.rows());
-    {
-      const Vector part = solve_system(principal_submatrix(a, rows), gather(c, rows), stats);
-      for (std::size_t i = 0; i < rows.size(); ++i) z(rows[i]) = part(static_cast<Eigen::Index>(i));
-    }
-    const bool singular = stats.singular != singular_before;
+    const Vector z = min_norm_on_free_set(equalities_, a, problem.rhs, free_rows, stats);
     if (!z.allFinite()) {
       ++stats.nan_caught;
       p.setZero();
       not_finite = true;
       break;
     }
-    // A singular system with an inconsistent right-hand side has no minimizer on F: the objective falls
-    // without bound along the residual d = c − A z (a null direction). Follow it to the first bound.
-    Vector d = c - a * z;
-    double inconsistency = 0.0;
-    for (std::size_t k = 0; k < m; ++k)
-      if (free_rows[k]) inconsistency = std::max(inconsistency, std::abs(d(static_cast<Eigen::Index>(k))));
-      else d(static_cast<Eigen::Index>(k)) = 0.0;
-    bool along_null = singular && inconsistency > 0.5 * problem.tolerance;
-    if (along_null) {  // keep d's clear components; if none is on an inequality row, z is the answer on F
-      along_null = false;
-      for (std::size_t k = 0; k < m; ++k) {
-        double& dk = d(static_cast<Eigen::Index>(k));
-        if (std::abs(dk) < 1e-6 * inconsistency) dk = 0.0;
-        along_null = along_null || (inequality(k) && dk != 0.0);
-      }
-    }
+    Vector d;
+    const bool along_null = null_direction(problem, z, free_rows, stats.singular != singular_before, d);
     Vector direction;  // p moves along `direction` by the ratio test, or p = z
     const double roundoff = kImpulseRoundoff * z.lpNorm<Eigen::Infinity>();
-    if (along_null) {
-      direction = d;
-    } else {
-      bool feasible = true;
-      for (std::size_t k = 0; k < m; ++k)
-        if (free_rows[k] && inequality(k) && z(static_cast<Eigen::Index>(k)) < -roundoff) feasible = false;
-      if (!feasible) direction = z - p;
-    }
+    if (along_null) direction = d;
+    else if (!feasible(z, free_rows, problem.equality, roundoff)) direction = z - p;
     if (direction.size() > 0) {
-      // Ratio test: the largest step keeping every free inequality row ≥ 0.
-      double step = std::numeric_limits<double>::infinity();
-      std::size_t blocking = m;
-      for (std::size_t k = 0; k < m; ++k) {
-        const auto i = static_cast<Eigen::Index>(k);
-        if (!free_rows[k] || !inequality(k) || !(direction(i) < 0.0)) continue;
-        const double ratio = std::max(0.0, p(i)) / -direction(i);
-        if (ratio < step) step = ratio, blocking = k;
-      }
-      if (blocking == m) {  // the objective falls without bound: the problem has no solution
+      // The largest step keeping every free inequality row ≥ 0 (at most 1 towards z, unbounded along
+      // the null direction); the blocking row is released even when the step is cut to 1.
+      RatioTest test = ratio_test(p, direction, free_rows, problem.equality, std::numeric_limits<double>::infinity());
+      if (test.blocking == m) {  // the objective falls without bound: the problem has no solution
         infeasible = true;
         ++stats.infeasible;
         break;
       }
-      if (!along_null) step = std::min(step, 1.0);
-      p += step * direction;
-      const double floor = kImpulseRoundoff * p.lpNorm<Eigen::Infinity>();
-      for (std::size_t k = 0; k < m; ++k) {
-        const auto i = static_cast<Eigen::Index>(k);
-        const bool falling = along_null ? direction(i) < 0.0 : z(i) < -roundoff;
-        if (free_rows[k] && inequality(k) && (k == blocking || (falling && p(i) <= floor))) {
-          free_rows[k] = 0;
-          p(i) = 0.0;
-          ++stats.released;
-        }
-      }
+      if (!along_null) test.step = std::min(test.step, 1.0);
+      // Falling: along the null direction, the rows it lowers; towards z, the rows z puts below zero.
+      step_and_release(p, direction, test, along_null ? direction : z, along_null ? 0.0 : roundoff, free_rows,
+                       problem.equality, stats);
       continue;
     }
     p = z;
-    // Add every row at zero that would approach.
-    const Vector w = a * p - c;
-    bool added = false;
-    for (std::size_t k = 0; k < m; ++k) {
-      const auto i = static_cast<Eigen::Index>(k);
-      if (inequality(k) && free_rows[k]) p(i) = std::max(p(i), 0.0);  // rounding below zero
-      if (!free_rows[k] && w(i) < -problem.tolerance) {
-        free_rows[k] = 1;
-        added = true;
-        ++stats.added;
-      }
-    }
-    if (!added) {
+    if (!add_approaching(problem, p, free_rows, stats)) {
       converged = true;
       break;
     }
   }
   if (!converged && !not_finite && !infeasible) ++stats.non_converged;
-  for (std::size_t k = 0; k < m; ++k)
-    if (inequality(k)) p(static_cast<Eigen::Index>(k)) = free_rows[k] ? std::max(p(static_cast<Eigen::Index>(k)), 0.0) : 0.0;
+  clamp_to_free_set(p, free_rows, problem.equality);
   return p;
 }
 
@@ -122,7 +129,7 @@ Vector IslandSolver::solve_complementarity_min_norm(const ComplementarityProblem
 // it, take the minimum-norm one (the paper's choice for its Figure 2: the impulse shared equally among
 // collinear contacts) if it keeps every impulse ≥ 0. It changes no velocity: p − p_min is a
 // self-equilibrated impulse set (A (p − p_min) = 0).
-void IslandSolver::polish_minimum_norm(const SparseMatrix& a, const Vector& c, std::vector<char> rows,
+void ComplementaritySolver::polish_minimum_norm(const SparseMatrix& a, const Vector& c, std::vector<char> rows,
                                        const ComplementarityProblem& problem, Vector& p, SolverStats& stats) {
   for (std::size_t k = 0; k < rows.size(); ++k)  // rows at zero with w = 0 may share the impulse too
     if (!rows[k] && !problem.equality[k]) {
@@ -134,7 +141,7 @@ void IslandSolver::polish_minimum_norm(const SparseMatrix& a, const Vector& c, s
   if (members_f.size() < 2 || members_f.size() > settings_.polish_limit) return;
   SolverStats ignored;
   const SparseMatrix sub = principal_submatrix(a, members_f);
-  const Vector q = solve_dense_matrix(Eigen::MatrixXd(sub), gather(c, members_f), ignored);
+  const Vector q = equalities_.solve_dense_matrix(Eigen::MatrixXd(sub), gather(c, members_f), ignored);
   const double roundoff = kImpulseRoundoff * q.lpNorm<Eigen::Infinity>();
   for (std::size_t i = 0; i < members_f.size(); ++i)
     if (!problem.equality[members_f[i]] && q(static_cast<Eigen::Index>(i)) < -roundoff) return;

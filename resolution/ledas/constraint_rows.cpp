@@ -1,4 +1,4 @@
-#include "ledas/constraint_rows.hpp"
+#include "impetus/resolution/ledas/constraint_rows.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -22,20 +22,15 @@ Vec3 predicted_point(const RigidBody& body, const Vec3& p, double dt) {
 void append_row(std::span<const RigidBody> bodies, resolution::InverseInertiaCache& inertia, BodyIndex a, BodyIndex b,
                 const Vec3& point_a, const Vec3& point_b, const Vec3& normal, ConstraintLevel level, double dt,
                 std::vector<ImpulseRow>& rows, std::vector<RowInfo>& info) {
-  ImpulseRow row = resolution::make_row(bodies, inertia, a, b, point_a, normal, 0.0);  // e = 0 (sec. 4)
-  if (const RigidBody& body_b = bodies[b]; !body_b.fixed) {  // b's arm from its own point
-    row.arm_b = (point_b - body_b.position).cross(normal);
-    row.turn_b = inertia.get(bodies, b) * row.arm_b;
-  }
+  const ImpulseRow row = resolution::make_row(bodies, inertia, a, b, point_a, point_b, normal);  // e = 0 (sec. 4)
   RowInfo ri;
-  ri.point_b = point_b;
   ri.equality = true;
   // eqs. 9–10: the joined points coincide after the step. Their separation along n after a step at the
   // current velocities is s⁺ (predicted exactly for eq. 2's rotation); an impulse changes it by dt times
   // the change of v_n, so the target is v_n⁺ = v_n⁻ − s⁺/dt (= −s/dt to first order in dt).
   if (level == ConstraintLevel::position) {
     ri.position_level = true;
-    ri.target = row_velocity(row, ri, bodies) - predicted_separation(row, ri, bodies, dt) / dt;
+    ri.target = resolution::row_velocity(row, bodies) - predicted_separation(row, bodies, dt) / dt;
   }
   rows.push_back(row);
   info.push_back(ri);
@@ -66,8 +61,8 @@ Vec3 foot_on_axis(const Vec3& q, const Vec3& origin, const Vec3& direction) {
 
 }  // namespace
 
-double predicted_separation(const ImpulseRow& row, const RowInfo& info, std::span<const RigidBody> bodies, double dt) {
-  return (predicted_point(bodies[row.b], info.point_b, dt) - predicted_point(bodies[row.a], row.point, dt)).dot(row.normal);
+double predicted_separation(const ImpulseRow& row, std::span<const RigidBody> bodies, double dt) {
+  return (predicted_point(bodies[row.b], row.point_b, dt) - predicted_point(bodies[row.a], row.point, dt)).dot(row.normal);
 }
 
 void append_constraint_rows(std::span<const RigidBody> bodies, resolution::InverseInertiaCache& inertia,

@@ -1,20 +1,17 @@
-// The island solver's set-up: construction, principal submatrices and the caches of symbolic
-// analyses. The solves themselves: equality_solve.cpp (the paper mode's rounds), complementarity.cpp
-// (the complementary mode and the position correction), complementarity_fallback.cpp.
-#include "ledas/island_solver.hpp"
-#include "ledas/masked_ldlt.hpp"
-#include "ledas/solver_internal.hpp"
+// The island solver: the two solvers it joins (equality_solver.hpp, complementarity_solver.hpp) and
+// principal submatrices.
+#include "impetus/resolution/ledas/island_solver.hpp"
+#include "complementarity_solver.hpp"
+#include "equality_solver.hpp"
+#include "solver_internal.hpp"
 
 #include <algorithm>
 
 namespace impetus::ledas {
 
-namespace {
-// Factorizations kept for reuse of their symbolic analysis (distinct sparsity patterns).
-constexpr std::size_t kCacheCapacity = 16;
-}  // namespace
-
-IslandSolver::IslandSolver(SolverSettings settings) : settings_(settings) {}
+IslandSolver::IslandSolver(SolverSettings settings)
+    : settings_(settings), equalities_(std::make_unique<EqualitySolver>(settings_)),
+      complementarity_(std::make_unique<ComplementaritySolver>(settings_, *equalities_)) {}
 IslandSolver::~IslandSolver() = default;
 
 SparseMatrix principal_submatrix(const SparseMatrix& a, std::span<const RowIndex> subset) {
@@ -32,53 +29,20 @@ SparseMatrix principal_submatrix(const SparseMatrix& a, std::span<const RowIndex
   return out;
 }
 
-IslandSolver::FactorPtr IslandSolver::checkout(const SparseMatrix& m, SolverStats& stats) {
-  const auto same_pattern = [&](const Factor& f) {
-    return f.outer.size() == static_cast<std::size_t>(m.cols()) + 1 &&
-           f.inner.size() == static_cast<std::size_t>(m.nonZeros()) &&
-           std::equal(f.outer.begin(), f.outer.end(), m.outerIndexPtr()) &&
-           std::equal(f.inner.begin(), f.inner.end(), m.innerIndexPtr());
-  };
-  for (auto it = cache_.begin(); it != cache_.end(); ++it) {
-    if (same_pattern(**it)) {
-      FactorPtr f = *it;
-      cache_.erase(it);
-      ++stats.symbolic_reused;
-      return f;
-    }
-  }
-  auto f = std::make_shared<Factor>();
-  f->ldlt.analyzePattern(m);
-  f->outer.assign(m.outerIndexPtr(), m.outerIndexPtr() + m.cols() + 1);
-  f->inner.assign(m.innerIndexPtr(), m.innerIndexPtr() + m.nonZeros());
-  ++stats.symbolic_analyses;
-  return f;
+Vector IslandSolver::solve_subset(const SparseMatrix& a, const Vector& c, std::span<const RowIndex> subset,
+                                  SolverStats& stats) {
+  Vector p = Vector::Zero(a.rows());
+  equalities_->solve_subset(a, c, subset, p, stats);
+  return p;
 }
 
-void IslandSolver::checkin(FactorPtr factor) {
-  cache_.push_back(std::move(factor));  // most recently used last
-  if (cache_.size() > kCacheCapacity) cache_.erase(cache_.begin());
+void IslandSolver::solve_subset(const SparseMatrix& a, const Vector& c, std::span<const RowIndex> subset, Vector& p,
+                                SolverStats& stats) {
+  equalities_->solve_subset(a, c, subset, p, stats);
 }
 
-std::unique_ptr<MaskedLdlt> IslandSolver::checkout_masked(const SparseMatrix& m, std::span<const char> likely,
-                                                         SolverStats& stats) {
-  for (auto it = masked_cache_.begin(); it != masked_cache_.end(); ++it) {
-    if ((*it)->same_pattern(m)) {
-      std::unique_ptr<MaskedLdlt> f = std::move(*it);
-      masked_cache_.erase(it);
-      ++stats.symbolic_reused;
-      return f;
-    }
-  }
-  auto f = std::make_unique<MaskedLdlt>();
-  f->analyze(m, likely);
-  ++stats.symbolic_analyses;
-  return f;
-}
-
-void IslandSolver::checkin_masked(std::unique_ptr<MaskedLdlt> factor) {
-  masked_cache_.push_back(std::move(factor));  // most recently used last
-  if (masked_cache_.size() > kCacheCapacity) masked_cache_.erase(masked_cache_.begin());
+Vector IslandSolver::solve_complementarity(const ComplementarityProblem& problem, SolverStats& stats) {
+  return complementarity_->solve(problem, stats);
 }
 
 }  // namespace impetus::ledas

@@ -1,13 +1,15 @@
 #pragma once
 /// \file
-/// Internals shared by the island solver's source files (island_solver.cpp: set-up and caches;
-/// equality_solve.cpp: the paper mode's equalities; complementarity.cpp: the proximal active set;
-/// complementarity_fallback.cpp: the minimum-norm fallback and polish). Not installed, not for tests.
+/// Internals shared by the island solver's source files (equality_solver.cpp, complementarity.cpp,
+/// complementarity_fallback.cpp, primal_step.cpp): the active-set loop's state and small helpers. Not
+/// installed, not for tests.
 
-#include "ledas/island_solver.hpp"
+#include "bordered_update.hpp"
+#include "complementarity_solver.hpp"
+#include "impetus/resolution/ledas/island_solver.hpp"
+#include "impetus/resolution/ledas/masked_ldlt.hpp"
 
-#include <Eigen/SparseCholesky>
-
+#include <memory>
 #include <span>
 #include <vector>
 
@@ -16,10 +18,16 @@ namespace impetus::ledas {
 // An impulse this far below zero, relative to the largest one, is rounding, not a pulling impulse.
 inline constexpr double kImpulseRoundoff = 1e-12;
 
-/// A sparse LDLᵀ (Eigen SimplicialLDLT, AMD ordering) with the pattern its symbolic analysis is for.
-struct IslandSolver::Factor {
-  Eigen::SimplicialLDLT<SparseMatrix, Eigen::Lower, Eigen::AMDOrdering<int>> ldlt;
-  std::vector<int> outer, inner;  // the sparsity pattern the symbolic analysis belongs to
+/// One active-set loop (solve_complementarity): its masked factorization of (A + εI)_BB and the
+/// bordered update against it.
+struct ComplementaritySolver::ActiveLoop {
+  std::unique_ptr<MaskedLdlt> factor;
+  bool factored = false;
+  double floor = 0.0;         // A_kk at or below this: nothing movable behind row k
+  bool singular = false;      // a factorization met a redundant row (pivot ≈ the shift)
+  bool widened = false;       // the analysis was redone for rows beyond the start set
+  std::vector<char> in_base;  // rows B of the last factorization (free and not dropped)
+  BorderedUpdate update;      // solves for active sets near B without refactoring
 };
 
 /// v restricted to `rows`, in their order.

@@ -1,7 +1,10 @@
-#include "mirtich/mirtich.hpp"
+#include "impetus/resolution/mirtich/mirtich.hpp"
+
+#include "impetus/resolution/common/incidence.hpp"
 
 #include <algorithm>
 #include <cmath>
+#include <span>
 #include <utility>
 #include <vector>
 
@@ -20,14 +23,16 @@ struct Workspace {
   std::vector<double> vn;        // current v_n of each row (m/s), refreshed after every impulse
   std::vector<double> impulse;   // accumulated p ≥ 0 (N·s)
   std::vector<char> usable;      // false for rows whose A_kk is not a finite positive number
-  std::vector<std::vector<std::uint32_t>> rows_of_body;  // movable body → its rows
+  resolution::Incidence incidence;  // rows ↔ movable bodies (slot = body index; fixed bodies: none)
   std::vector<std::size_t> local;  // row → its position in the island being corrected
 
   // Every row sharing a movable body with row k (k included, each once), sorted.
   std::vector<std::uint32_t> neighbours(std::uint32_t k) const {
     std::vector<std::uint32_t> out;
-    for (BodyIndex s : {rows[k].a, rows[k].b})
-      out.insert(out.end(), rows_of_body[s].begin(), rows_of_body[s].end());
+    for (const std::int32_t s : incidence.slots[k]) {
+      const std::span<const std::uint32_t> of_body = incidence.rows_of(s);
+      out.insert(out.end(), of_body.begin(), of_body.end());
+    }
     std::sort(out.begin(), out.end());
     out.erase(std::unique(out.begin(), out.end()), out.end());
     return out;
@@ -52,9 +57,31 @@ bool apply_single_impulse(std::uint32_t k, Workspace& ws, std::span<RigidBody> b
   }
   resolution::apply_row_impulse(row, p, bodies);
   ws.impulse[k] += p;
-  for (BodyIndex s : {row.a, row.b})
-    for (std::uint32_t i : ws.rows_of_body[s]) ws.vn[i] = resolution::row_velocity(ws.rows[i], bodies);
+  for (const std::int32_t s : ws.incidence.slots[k])
+    for (std::uint32_t i : ws.incidence.rows_of(s)) ws.vn[i] = resolution::row_velocity(ws.rows[i], bodies);
   return true;
+}
+
+// The usable row of `island` with the most negative v_n below −tol into `best` (the strict comparison
+// keeps the lowest index among ties); false if none approaches. This scan is the sweep's hot loop (one
+// pass over the island per impulse), so it is its own function aligned to a cache line: its speed
+// depends on the loop not straddling an instruction-fetch window, which the surrounding code's layout
+// would otherwise decide.
+[[gnu::aligned(64), gnu::noinline]] bool most_approaching(std::span<const std::uint32_t> island,
+                                                          std::span<const char> usable, std::span<const double> vn,
+                                                          double tol, std::uint32_t& best) {
+  std::uint32_t row = 0;
+  double best_vn = -tol;
+  bool found = false;
+  for (std::uint32_t k : island) {
+    if (usable[k] && vn[k] < best_vn) {
+      row = k;
+      best_vn = vn[k];
+      found = true;
+    }
+  }
+  best = row;
+  return found;
 }
 
 // The velocity sweep over one island. Returns the number of single impulses applied; `capped` tells
@@ -68,18 +95,8 @@ std::uint64_t sweep_island(const std::vector<std::uint32_t>& island, Workspace& 
   capped = false;
   if (settings.order == MirtichOrder::most_approaching) {
     for (;;) {
-      // Most negative v_n; the strict comparison keeps the lowest index among ties.
       std::uint32_t best = 0;
-      double best_vn = -tol;
-      bool found = false;
-      for (std::uint32_t k : island) {
-        if (ws.usable[k] && ws.vn[k] < best_vn) {
-          best = k;
-          best_vn = ws.vn[k];
-          found = true;
-        }
-      }
-      if (!found) break;
+      if (!most_approaching(island, ws.usable, ws.vn, tol, best)) break;
       if (applied >= cap) {
         capped = true;
         break;
@@ -186,7 +203,6 @@ void MirtichResolver::resolve(std::span<RigidBody> bodies, std::span<Contact> co
     ws.impulse.assign(m, 0.0);
     ws.usable.assign(m, 1);
     ws.local.assign(m, 0);
-    ws.rows_of_body.resize(bodies.size());
     for (std::uint32_t k = 0; k < m; ++k) {
       const ImpulseRow& row = ws.rows[k];
       ws.a_kk[k] = resolution::self_coupling(row);
@@ -195,9 +211,12 @@ void MirtichResolver::resolve(std::span<RigidBody> bodies, std::span<Contact> co
         ws.usable[k] = 0;  // e.g. a contact between two fixed bodies: no impulse can act on it
         if (!bodies[row.a].fixed || !bodies[row.b].fixed) ++counters.singular_systems;
       }
-      for (BodyIndex s : {row.a, row.b})
-        if (!bodies[s].fixed) ws.rows_of_body[s].push_back(k);
     }
+    std::vector<std::uint32_t> all(m);
+    std::vector<std::int32_t> slot_of_body(bodies.size());
+    for (std::uint32_t k = 0; k < m; ++k) all[k] = k;
+    for (std::size_t s = 0; s < bodies.size(); ++s) slot_of_body[s] = bodies[s].fixed ? -1 : static_cast<std::int32_t>(s);
+    ws.incidence = resolution::Incidence(ws.rows, all, bodies.size(), slot_of_body);
 
     const auto islands = resolution::find_islands(ws.rows, bodies.size(), bodies);
     for (const auto& island : islands) {

@@ -1,5 +1,5 @@
 // The shared resolver algebra: A = G M⁻¹ Gᵀ (eq. 7 with docs/conventions.md's reading) and eq. 3's impulses.
-#include "common/impulse_rows.hpp"
+#include "impetus/resolution/common/impulse_rows.hpp"
 
 #include "impetus/core/mass.hpp"
 

@@ -5,7 +5,7 @@
 #include "impetus/engine/metrics.hpp"
 #include "impetus/modules/contact.hpp"
 #include "impetus/modules/detector.hpp"
-#include "ledas/ledas.hpp"
+#include "impetus/resolution/ledas/ledas.hpp"
 
 #include <cmath>
 #include <span>

@@ -1,6 +1,6 @@
 // The island solver on its own: the complementarity solution against brute force, minimum-norm
 // solutions of singular systems against the pseudo-inverse, the update path against refactoring.
-#include "ledas/island_solver.hpp"
+#include "impetus/resolution/ledas/island_solver.hpp"
 
 #include <gtest/gtest.h>
 

@@ -2,8 +2,8 @@
 // LDLᵀ against dense algebra, the proximal complementarity solve on rank-deficient start sets, and the
 // paper mode's cheap rounds against the rounds written out literally (sec. 3.2).
 #include "impetus/engine/generators.hpp"
-#include "ledas/island_solver.hpp"
-#include "ledas/masked_ldlt.hpp"
+#include "impetus/resolution/ledas/island_solver.hpp"
+#include "impetus/resolution/ledas/masked_ldlt.hpp"
 #include "ledas_test_support.hpp"
 
 #include <gtest/gtest.h>

@@ -6,7 +6,7 @@
 #include "impetus/core/mass.hpp"
 #include "impetus/engine/metrics.hpp"
 #include "impetus/modules/contact.hpp"
-#include "mirtich/mirtich.hpp"
+#include "impetus/resolution/mirtich/mirtich.hpp"
 
 #include <gtest/gtest.h>
 

@@ -27,7 +27,10 @@ namespace impetus::resolution {
 struct ImpulseRow {
   BodyIndex a = 0, b = 0;
   Vec3 normal = Vec3::UnitZ();  ///< unit, out of a into b
-  Vec3 point = Vec3::Zero();    ///< world point where the impulse acts
+  Vec3 point = Vec3::Zero();    ///< world point where the impulse acts on a (m)
+  /// World point where the impulse acts on b (m): `point` for a contact; a joint row's own point on b,
+  /// which drifts from a's as the joint opens (arm_b is taken from it).
+  Vec3 point_b = Vec3::Zero();
   double inv_mass_a = 0.0, inv_mass_b = 0.0;
   Vec3 arm_a = Vec3::Zero(), arm_b = Vec3::Zero();  ///< r_s × n (m)
   Vec3 turn_a = Vec3::Zero(), turn_b = Vec3::Zero(); ///< J_s⁻¹ (r_s × n) (1/(kg·m))
@@ -46,8 +49,7 @@ class InverseInertiaCache {
   const Mat3& get(std::span<const RigidBody> bodies, BodyIndex index) {
     if (generation_of_[index] != generation_) {
       generation_of_[index] = generation_;
-      // Evaluated in place: copying a returned matrix in cost a failed store forwarding per body, a
-      // quarter of a row's set-up.
+      // Evaluated in place: copying a returned matrix in costs a failed store forwarding per body.
       bodies[index].inv_inertia_world(matrix_[index]);
     }
     return matrix_[index];
@@ -65,6 +67,9 @@ ImpulseRow make_row(std::span<const RigidBody> bodies, BodyIndex ia, BodyIndex i
 /// The same row, taking the bodies' J⁻¹ from `inertia` (reset() for `bodies` at their current poses).
 ImpulseRow make_row(std::span<const RigidBody> bodies, InverseInertiaCache& inertia, BodyIndex ia, BodyIndex ib,
                     const Vec3& point, const Vec3& normal, double restitution = 0.0);
+/// A row acting at `point_a` on a and `point_b` on b (a joint row), e = 0, J⁻¹ from `inertia`.
+ImpulseRow make_row(std::span<const RigidBody> bodies, InverseInertiaCache& inertia, BodyIndex ia, BodyIndex ib,
+                    const Vec3& point_a, const Vec3& point_b, const Vec3& normal);
 
 /// The row of a contact, with the combined restitution of its bodies.
 ImpulseRow make_contact_row(std::span<const RigidBody> bodies, const Contact& contact);
@@ -95,9 +100,21 @@ inline double coupling(const ImpulseRow& i, const ImpulseRow& k) {
 /// A_kk = 1/m_eff of a single row: n·n/M_a + (r_a×n)·J_a⁻¹(r_a×n) + the same for b.
 inline double self_coupling(const ImpulseRow& row) { return coupling(row, row); }
 
-/// v_n = (u_b − u_a)·n of the row at the bodies' current velocities (m/s; < 0 approaches).
+/// v_n = (u_b(point_b) − u_a(point))·n of the row at the bodies' current velocities, u = v + ω × r
+/// (eq. 5; m/s, < 0 approaches). Inline: evaluated for every row after every round.
 inline double row_velocity(const ImpulseRow& row, std::span<const RigidBody> bodies) {
-  return (bodies[row.b].velocity_at(row.point) - bodies[row.a].velocity_at(row.point)).dot(row.normal);
+  return (bodies[row.b].velocity_at(row.point_b) - bodies[row.a].velocity_at(row.point)).dot(row.normal);
+}
+
+/// Body a's share of the row's v_n in Jacobian form, n·v_a + (r_a×n)·ω_a (m/s; eq. 5 with
+/// (ω×r)·n = ω·(r×n)); v_n = movable_share_b − movable_share_a for two movable bodies. Zero arm for a
+/// fixed body: its share is then only n·v_a.
+inline double movable_share_a(const ImpulseRow& row, const RigidBody& a) {
+  return row.normal.dot(a.velocity) + row.arm_a.dot(a.angular_velocity);
+}
+/// Body b's share of the row's v_n in Jacobian form, n·v_b + (r_b×n)·ω_b (m/s).
+inline double movable_share_b(const ImpulseRow& row, const RigidBody& b) {
+  return row.normal.dot(b.velocity) + row.arm_b.dot(b.angular_velocity);
 }
 
 /// Applies impulse magnitude `p` along the row (eq. 3): −p n on a, +p n on b. Fixed bodies unchanged.

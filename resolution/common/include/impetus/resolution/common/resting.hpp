@@ -1,6 +1,6 @@
 #pragma once
 /// \file
-/// Resting contact, shared by every impulse resolver (issue: resolvers, item 3).
+/// Resting contact, shared by every impulse resolver.
 ///
 /// With the default split step (velocities → detect → resolve → positions; docs/conventions.md, "The
 /// step") a resting body does not sink: the resolver removes the approach that gravity added before
@@ -17,8 +17,8 @@
 /// gets e = 0. It is judged per island, not per contact, because in a simultaneous impact touching
 /// contacts (v_n = 0) carry the restitution phase too (Newton's cradle: (1 + e) p on every contact).
 
-#include "common/impulse_rows.hpp"
 #include "impetus/modules/options.hpp"
+#include "impetus/resolution/common/impulse_rows.hpp"
 
 #include <algorithm>
 

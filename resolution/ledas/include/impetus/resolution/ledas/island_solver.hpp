@@ -5,8 +5,7 @@
 /// A = G M⁻¹ Gᵀ) and a right-hand side come in, impulses come out, so it is tested directly.
 ///
 /// Equalities on a subset (the paper mode's rounds): the subset splits into independent blocks (rows
-/// coupled through a shared movable body), each solved by the cheapest exact method (docs/architecture.md,
-/// "Model no more than a scene needs"):
+/// coupled through a shared movable body), each solved by the cheapest exact method:
 ///  - one row: closed form p = c / A_11;
 ///  - up to `dense_limit` rows: dense LDLᵀ with diagonal pivoting (rank-revealing for a PSD matrix);
 ///  - more rows: sparse LDLᵀ (Eigen SimplicialLDLT, AMD ordering; symbolic analysis cached by pattern);
@@ -22,10 +21,11 @@
 /// searched, and each candidate free set tried on the problem itself by preconditioned conjugate
 /// gradients; exact to 1e-3 · tolerance on the free rows.
 ///
-/// Sources: island_solver.cpp (set-up, caches), equality_solve.cpp (the paper mode's subsets),
-/// complementarity.cpp (the proximal active set), complementarity_fallback.cpp (minimum-norm fallback
-/// and polish). No minimum-norm solve inside the loop (the velocities are unique, the impulses are not); a
-/// minimum-norm polish at the end where the system is small. README.md derives it.
+/// Sources: equality_solver.cpp (the paper mode's subsets), complementarity.cpp (the proximal active
+/// set), complementarity_fallback.cpp (minimum-norm fallback and polish), primal_step.cpp,
+/// bordered_update.cpp, masked_ldlt.cpp. No minimum-norm solve inside the loop (the velocities are
+/// unique, the impulses are not); a minimum-norm polish at the end where the system is small.
+/// resolution/ledas/README.md derives it.
 
 #include <Eigen/Dense>
 #include <Eigen/SparseCholesky>
@@ -38,7 +38,8 @@
 
 namespace impetus::ledas {
 
-class MaskedLdlt;
+class EqualitySolver;
+class ComplementaritySolver;
 
 /// Column-major sparse matrix with both triangles stored (A is symmetric).
 using SparseMatrix = Eigen::SparseMatrix<double>;
@@ -104,8 +105,10 @@ struct ComplementarityProblem {
   double tolerance = 1e-9;               ///< w below −tolerance is a violation (units of w)
 };
 
-/// Solves island systems exactly. Holds the cache of sparse symbolic analyses, so one instance per
-/// resolver; not thread-safe.
+/// Solves island systems exactly: two solvers behind one interface, the equality solver of the paper
+/// mode (equality_solver.hpp) and the complementarity solver (complementarity_solver.hpp), which uses
+/// the first for its fallback. Holds their caches of symbolic analyses, so one instance per resolver;
+/// not thread-safe.
 class IslandSolver {
  public:
   explicit IslandSolver(SolverSettings settings = {});
@@ -122,91 +125,23 @@ class IslandSolver {
   void solve_subset(const SparseMatrix& a, const Vector& c, std::span<const RowIndex> subset, Vector& p,
                     SolverStats& stats);
 
-  /// Solves the complementarity problem (complementarity.cpp, README.md): proximal-point outer iterations
-  /// on ½ pᵀ(A + εI) p − (c + ε p̄)ᵀp, ε = regularization · max A_kk for the first solve and
+  /// Solves the complementarity problem (complementarity.cpp, resolution/ledas/README.md): proximal-point
+  /// outer iterations on ½ pᵀ(A + εI) p − (c + ε p̄)ᵀp, ε = regularization · max A_kk for the first solve and
   /// search_regularization · max A_kk while the active set is searched, each subproblem by block
   /// principal pivoting while the number of infeasible rows falls, then the primal active-set method
   /// (monotone: it terminates), started from the given set; each solved subproblem's free set F is tried
   /// on the problem itself (A_FF p = c_F by preconditioned conjugate gradients). Returns p with p ≥ 0 on inequality rows, w ≥ −tolerance
   /// and |w| ≤ 1e-3 · tolerance on the rows with p ≠ 0; the minimum-norm split where the final system has
   /// at most polish_limit rows and that split is ≥ 0. Conflicting targets (no exact solution): the
-  /// minimum-norm least-squares active set of solve_complementarity_min_norm.
+  /// minimum-norm least-squares active set (complementarity_fallback.cpp).
   Vector solve_complementarity(const ComplementarityProblem& problem, SolverStats& stats);
 
   const SolverSettings& settings() const { return settings_; }
 
  private:
-  struct Factor;
-  using FactorPtr = std::shared_ptr<Factor>;
-
-  struct ActiveLoop {  // one active-set loop: its masked factorization and the rows it holds
-    std::unique_ptr<MaskedLdlt> factor;
-    bool factored = false;
-    double floor = 0.0;               // A_kk at or below this: nothing movable behind row k
-    bool singular = false;            // a factorization met a redundant row (pivot ≈ the shift)
-    bool widened = false;             // the analysis was redone for rows beyond the start set
-    std::vector<char> in_base;        // rows of the last factorization (free and not dropped)
-    // Border columns of the updates against the last factorization (solve_updated): per row that
-    // joined or left F, w = L⁻¹ P u (sparse), and the Gram matrix G_ij = w_iᵀ D⁻¹ w_j of those
-    // computed so far. Kept while the factorization is, so a growing change costs only its new rows.
-    struct Border {
-      std::vector<int> index;  // elimination order, increasing
-      std::vector<double> value;
-    };
-    std::vector<Border> borders;
-    std::vector<int> border_of;       // per row: its entry in borders, or −1
-    Eigen::MatrixXd gram;
-    // The last update: the free set it solves for, its added and removed rows (their entries in
-    // borders, added first) and the factorized Schur system; reused while the free set stays.
-    bool updated = false;
-    std::vector<char> updated_for;
-    std::vector<RowIndex> added, removed;
-    std::vector<int> slots;
-    Eigen::FullPivLU<Eigen::MatrixXd> schur;
-    Vector forward;                   // apply_update's t = L⁻¹ P c
-    Vector scattered;                 // border()'s D⁻¹ w, zero between calls
-
-    void refactored();                // forgets the borders and the update of the old factorization
-  };
-  struct Workspace {  // reused buffers (no allocation per round once warm)
-    std::vector<int> slot, parent, start, fill, members;  // subset components
-    Eigen::MatrixXd dense;
-    Vector rhs;
-    Vector diagonal;  // A_kk of the complementarity problem being solved
-    Vector residual, preconditioned, direction, product;  // refine_on_free_set
-    std::vector<char> solved_rows;
-    std::vector<Eigen::Index> unsolved_rows;
-  };
-
-  void factorize_loop(ActiveLoop& loop, const SparseMatrix& a, const std::vector<char>& rows, double shift,
-                      SolverStats& stats);
-  Vector solve_active(const SparseMatrix& a, double shift, const Vector& r, const std::vector<char>& active,
-                      ActiveLoop& loop, SolverStats& stats);
-  enum class Refinement { exact, infeasible, not_converged };
-  Refinement refine_on_free_set(const SparseMatrix& a, const Vector& c, double shift, const std::vector<char>& free_rows,
-                                ActiveLoop& loop, const ComplementarityProblem& problem, Vector& x, SolverStats& stats);
-  Vector solve_complementarity_min_norm(const ComplementarityProblem& problem, SolverStats& stats);
-  Vector solve_system(const SparseMatrix& m, const Vector& rhs, SolverStats& stats);
-  Vector solve_dense_matrix(const Eigen::MatrixXd& a, const Vector& rhs, SolverStats& stats);
-  Vector solve_sparse(const SparseMatrix& m, const Vector& rhs, double pivot_floor, SolverStats& stats);
-  bool solve_updated(ActiveLoop& loop, const SparseMatrix& a, double shift, const Vector& c,
-                     const std::vector<char>& active, Vector& p, SolverStats& stats);
-  static void apply_update(ActiveLoop& loop, const Vector& c, Vector& out);
-  static int border(ActiveLoop& loop, const SparseMatrix& a, RowIndex row);
-  void polish_minimum_norm(const SparseMatrix& a, const Vector& c, std::vector<char> rows,
-                           const ComplementarityProblem& problem, Vector& p, SolverStats& stats);
-  FactorPtr checkout(const SparseMatrix& m, SolverStats& stats);
-  void checkin(FactorPtr factor);
-  /// A masked factorization of m's pattern: the cached one if there is one (analysed for the rows of an
-  /// earlier start set: factorize_loop widens it when a free set needs more), else a new analysis for
-  /// the rows `likely` to be free (the start set; MaskedLdlt::analyze).
-  std::unique_ptr<MaskedLdlt> checkout_masked(const SparseMatrix& m, std::span<const char> likely, SolverStats& stats);
-  void checkin_masked(std::unique_ptr<MaskedLdlt> factor);
-
   SolverSettings settings_;
-  std::vector<FactorPtr> cache_;  // sparse factorizations by pattern, least recently used first
-  std::vector<std::unique_ptr<MaskedLdlt>> masked_cache_;  // active-set factorizations by pattern, ditto
-  Workspace work_;
+  std::unique_ptr<EqualitySolver> equalities_;               // solve_subset (equality_solver.cpp)
+  std::unique_ptr<ComplementaritySolver> complementarity_;  // solve_complementarity (complementarity.cpp)
 };
 
 /// The principal submatrix A_SS of `a` for the rows `subset` (increasing).

@@ -2,19 +2,19 @@
 /// \file
 /// The sequential baseline resolver: one approaching contact at a time, each with the exact
 /// single-contact frictionless impulse (Mirtich 1996, the paper's reference [4]; the paper's sec. 1
-/// argues against it with Figure 1 and the "almost freezing" stacks). See README.md for what it
-/// assumes, guarantees and where it fails.
+/// argues against it with Figure 1 and the "almost freezing" stacks). See resolution/mirtich/README.md
+/// for what it assumes, guarantees and where it fails.
 ///
-/// Notation (shared with resolution/common/impulse_rows.hpp): a contact k is a row with relative normal
+/// Notation (shared with impetus/resolution/common/impulse_rows.hpp): a contact k is a row with relative normal
 /// velocity v_k = (u_b − u_a)·n_k (< 0 approaches) and A_kk = 1/m_eff (eq. 7 for i = k). Its single
 /// impulse is
 ///   p_k = −(1 + e_k) v_k / A_kk,
 /// which leaves v_k⁺ = −e_k v_k exactly (the paper's eq. 6 for m = 1, with the restitution of sec. 3.2).
 
-#include "common/impulse_rows.hpp"
-#include "common/resting.hpp"
 #include "impetus/modules/options.hpp"
 #include "impetus/modules/resolver.hpp"
+#include "impetus/resolution/common/impulse_rows.hpp"
+#include "impetus/resolution/common/resting.hpp"
 
 #include <cstdint>
 
@@ -53,7 +53,7 @@ struct MirtichSettings {
 ///  1. velocity sweep: while some contact approaches (v_n < −tolerance) and the island's cap is not
 ///     reached, pick one (MirtichOrder) and apply p = −(1 + e) v_n / A_kk with
 ///     e = effective_restitution(row, −v_n of that contact, resting): each single collision gets its
-///     own impact speed (see README.md for why this differs from `ledas`);
+///     own impact speed (see resolution/mirtich/README.md for why this differs from `ledas`);
 ///  2. position correction: Gauss–Seidel on pseudo-impulses q ≥ 0 (projected, accumulated) so that
 ///     A q ≥ correction_target(depth) with complementarity, then apply_row_displacement; velocities are
 ///     not touched by it.

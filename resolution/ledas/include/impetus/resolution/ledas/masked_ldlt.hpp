@@ -19,12 +19,51 @@
 
 #include <Eigen/SparseCore>
 
+#include <cstddef>
 #include <cstdint>
 #include <span>
+#include <type_traits>
 #include <utility>
 #include <vector>
 
 namespace impetus::ledas {
+
+/// The index type of the sparse kernels: Eigen's storage index of SparseMatrix<double> (int). Rows,
+/// columns, entries of L and elimination-tree links all use it, so no kernel converts between index types.
+using SparseIndex = int;
+
+/// A std::vector indexed by SparseIndex: the kernels' one conversion to the vector's size type is here.
+template <class T>
+class IndexVector {
+ public:
+  IndexVector() = default;
+  IndexVector(SparseIndex n, const T& value) : data_(static_cast<std::size_t>(n), value) {}
+  template <class It>
+    requires(!std::is_integral_v<It>)
+  IndexVector(It first, It last) : data_(first, last) {}
+
+  T& operator[](SparseIndex i) { return data_[static_cast<std::size_t>(i)]; }
+  const T& operator[](SparseIndex i) const { return data_[static_cast<std::size_t>(i)]; }
+  SparseIndex size() const { return static_cast<SparseIndex>(data_.size()); }
+  bool empty() const { return data_.empty(); }
+  void assign(SparseIndex n, const T& value) { data_.assign(static_cast<std::size_t>(n), value); }
+  template <class It>
+    requires(!std::is_integral_v<It>)
+  void assign(It first, It last) { data_.assign(first, last); }
+  void resize(SparseIndex n) { data_.resize(static_cast<std::size_t>(n)); }
+  void clear() { data_.clear(); }
+  void push_back(const T& value) { data_.push_back(value); }
+  T& back() { return data_.back(); }
+  T* data() { return data_.data(); }
+  const T* data() const { return data_.data(); }
+  auto begin() { return data_.begin(); }
+  auto end() { return data_.end(); }
+  auto begin() const { return data_.begin(); }
+  auto end() const { return data_.end(); }
+
+ private:
+  std::vector<T> data_;
+};
 
 class MaskedLdlt {
  public:
@@ -39,7 +78,7 @@ class MaskedLdlt {
   /// Whether every row of F = {k : on[k] != 0} was analysed (else analyze again with them).
   bool covers(std::span<const char> on) const;
   /// Whether row k was analysed.
-  bool analysed(std::size_t k) const { return analysed_[k] != 0; }
+  bool analysed(std::size_t k) const { return analysed_[static_cast<SparseIndex>(k)] != 0; }
   /// Whether `a` has the pattern analyze() was given.
   bool same_pattern(const Matrix& a) const;
 
@@ -63,10 +102,10 @@ class MaskedLdlt {
   /// outside the factorization are ignored): w = L⁻¹ P u as its non-zeros (elimination order,
   /// increasing). It visits only the elimination-tree ancestors of u's rows (every entry L_ij lies on
   /// the path from j to the root), about the tree's height in columns instead of all of them.
-  void forward_sparse(std::span<const std::pair<int, double>> u, std::vector<int>& index,
+  void forward_sparse(std::span<const std::pair<SparseIndex, double>> u, std::vector<SparseIndex>& index,
                       std::vector<double>& value) const;
   /// 1/d_i of row i in elimination order: 0 off the factorization and on dropped rows.
-  double pivot_inverse(int i) const { return d_inverse_[static_cast<std::size_t>(i)]; }
+  double pivot_inverse(SparseIndex i) const { return d_inverse_[i]; }
   /// Flops (multiply-adds) of the last factorize(): the cost an update is weighed against.
   double factorization_work() const { return work_; }
 
@@ -74,31 +113,37 @@ class MaskedLdlt {
   /// dependent on the rows eliminated before them (A_FF is singular if there is one).
   std::size_t redundant_rows(double shift) const;
   /// Whether row k (original index) was dropped by the last factorize().
-  bool dropped(std::size_t k) const { return state_[static_cast<std::size_t>(new_of_old_[k])] == kDropped; }
-  std::size_t rows() const { return order_.size(); }
+  bool dropped(std::size_t k) const { return state_[new_of_old_[static_cast<SparseIndex>(k)]] == kDropped; }
+  std::size_t rows() const { return static_cast<std::size_t>(order_.size()); }
   /// Entries of L the full pattern allows (work per solve ~ 2× this).
-  std::size_t capacity() const { return l_index_.size(); }
+  std::size_t capacity() const { return static_cast<std::size_t>(l_index_.size()); }
 
  private:
   static constexpr char kOff = 0, kOn = 1, kDropped = 2;
-  static std::vector<int> minimum_degree(const Matrix& a);
+  static IndexVector<SparseIndex> minimum_degree(const Matrix& a);
+  // The steps of analyze(): order_ and new_of_old_; the upper triangle of P A Pᵀ; the elimination tree,
+  // column counts and column starts of L; the pattern of each row of L.
+  void order_rows(const Matrix& a);
+  void upper_triangle();
+  void elimination_tree();
+  void row_patterns();
 
-  std::vector<int> outer_, inner_;       // the pattern of A
-  std::vector<char> analysed_;           // per row: in the analysed pattern (may be in F)
-  std::vector<int> order_, new_of_old_;  // order_[new] = old
+  IndexVector<SparseIndex> outer_, inner_;       // the pattern of A
+  IndexVector<char> analysed_;                   // per row: in the analysed pattern (may be in F)
+  IndexVector<SparseIndex> order_, new_of_old_;  // order_[new] = old
   // Upper triangle of P A Pᵀ by columns (rows i ≤ k), each entry pointing into A's value array.
-  std::vector<int> c_outer_, c_row_, c_value_;
-  std::vector<int> parent_, l_outer_;    // elimination tree; column starts of L
-  std::vector<int> l_count_, l_index_;
-  std::vector<int> row_outer_, row_index_;  // pattern of each row of L for the full pattern (topological)
-  std::vector<double> l_value_, d_, d_inverse_, diag_;  // d_inverse_: 1/d on rows of F kept, else 0
-  std::vector<char> state_;
+  IndexVector<SparseIndex> c_outer_, c_row_, c_value_;
+  IndexVector<SparseIndex> parent_, l_outer_;    // elimination tree; column starts of L
+  IndexVector<SparseIndex> l_count_, l_index_;
+  IndexVector<SparseIndex> row_outer_, row_index_;  // pattern of each row of L for the full pattern (topological)
+  IndexVector<double> l_value_, d_, d_inverse_, diag_;  // d_inverse_: 1/d on rows of F kept, else 0
+  IndexVector<char> state_;
   // Workspace.
-  mutable std::vector<double> y_;
-  std::vector<int> flag_, pattern_;
-  mutable Eigen::VectorXd scratch_;           // solve()'s intermediate vector
-  mutable std::vector<int> reach_, visited_;  // forward_sparse: the ancestors, a visit stamp per row
-  mutable int stamp_ = 0;
+  mutable IndexVector<double> y_;
+  IndexVector<SparseIndex> flag_, pattern_;
+  mutable Eigen::VectorXd scratch_;                      // solve()'s intermediate vector
+  mutable IndexVector<SparseIndex> reach_, visited_;     // forward_sparse: the ancestors, a visit stamp per row
+  mutable SparseIndex stamp_ = 0;
   double work_ = 0.0;
 };
 

@@ -1,25 +1,30 @@
 #pragma once
 /// \file
-/// The LEDAS simultaneous impulse resolver (Ermolin & Kazakov, "Impulse-based Approach for Rigid Body Collisions Simultaneous Resolution"; docs/conventions.md).
-/// README.md derives A and b with their signs, lists the paper's typos as fixed, and says what the
-/// method assumes, guarantees and where it fails.
+/// The LEDAS simultaneous impulse resolver (Ermolin & Kazakov, "Impulse-based Approach for Rigid Body
+/// Collisions Simultaneous Resolution"; conventions and typos in docs/conventions.md).
+/// resolution/ledas/README.md derives A and b with their signs and says what the method assumes,
+/// guarantees and where it fails.
 ///
-/// Notation (resolution/common/impulse_rows.hpp): row k (a contact or a joint direction) has
+/// Notation (impetus/resolution/common/impulse_rows.hpp): row k (a contact or a joint direction) has
 /// v_k = (u_b − u_a)·n_k (< 0 approaches); impulses p act −p n on a and +p n on b (eq. 3, sign fixed);
 /// the rows' velocities change by A p with A = G M⁻¹ Gᵀ (eq. 7), and eq. 4's inelastic condition is
 /// A p = b with b = target − v⁻ (eq. 8 with its sign fixed; target = 0 for a touching contact).
 
-#include "common/impulse_rows.hpp"
-#include "common/resting.hpp"
 #include "impetus/modules/options.hpp"
 #include "impetus/modules/resolver.hpp"
-#include "ledas/constraint_rows.hpp"
-#include "ledas/island_solver.hpp"
+#include "impetus/resolution/common/impulse_rows.hpp"
+#include "impetus/resolution/common/resting.hpp"
+#include "impetus/resolution/ledas/constraint_rows.hpp"
+#include "impetus/resolution/ledas/island_solver.hpp"
 
 #include <cstdint>
 #include <vector>
 
 namespace impetus {
+
+namespace ledas {
+struct Island;  // one island's working data (island.hpp)
+}  // namespace ledas
 
 /// Which contacts enter the system and how it is solved.
 enum class LedasMode : std::uint8_t {
@@ -33,8 +38,9 @@ enum class LedasMode : std::uint8_t {
   complementary
 };
 
-/// Which touching contacts the complementary mode's active-set search starts with (README.md, "The
-/// start set"). Only the first guess of the active set: the answer is the same either way.
+/// Which touching contacts the complementary mode's active-set search starts with
+/// (resolution/ledas/README.md, "The start set"). Only the first guess of the active set: the answer is
+/// the same either way.
 enum class LedasStartSet : std::uint8_t {
   /// Approaching contacts, and the touching ones that can pass the impact on: to a fixed body, or
   /// between two bodies at different distances (contact hops) from the impact. A touching contact across
@@ -62,7 +68,7 @@ struct LedasSettings {
   /// one system (`islands: false`: the same velocities up to rounding, with the bounce threshold judged
   /// over all rows; only slower or faster, as benchmarks/model.cpp measures).
   bool islands = true;
-  /// Options `slop`, `correction`, `bounce_threshold` (resolution/common/resting.hpp).
+  /// Options `slop`, `correction`, `bounce_threshold` (impetus/resolution/common/resting.hpp).
   resolution::RestingSettings resting;
 
   /// Reads every option above; throws OptionError for a bad value.
@@ -119,17 +125,26 @@ class LedasResolver final : public CollisionResolver {
   const LedasStats& last_stats() const { return stats_; }
 
  private:
-  struct Island;
+  // The stages of one resolve(), each in its own file: ledas.cpp (rows, islands, report), island.cpp
+  // (an island's system), paper_rounds.cpp, complementary_impact.cpp, restitution.cpp,
+  // position_correction.cpp.
   void resolve_all(std::span<RigidBody> bodies, std::span<Contact> contacts, std::span<const Constraint> constraints,
                    const StepContext& ctx, ResolverCounters& counters);
-  Island make_island(std::vector<std::uint32_t> rows, std::span<const RigidBody> bodies, double dt);
-  const ledas::Vector& current_velocities(Island& island, std::span<const RigidBody> bodies) const;
-  void velocity_paper(Island& island, std::span<RigidBody> bodies, ResolverCounters& counters);
-  void velocity_complementary(Island& island, std::span<RigidBody> bodies, ResolverCounters& counters);
-  void narrow_start_set(const Island& island, const ledas::Vector& v, std::vector<char>& start);
-  bool retarget_joints(Island& island, const ledas::Vector& v, std::span<const RigidBody> bodies) const;
-  void finish_round(Island& island, const ledas::Vector& p, const ledas::Vector& target, std::span<RigidBody> bodies);
-  void correct_positions(Island& island, std::span<RigidBody> bodies);
+  void build_rows(std::span<const RigidBody> bodies, std::span<Contact> contacts,
+                  std::span<const Constraint> constraints, double dt, ResolverCounters& counters);
+  void solve_island(std::vector<std::uint32_t> rows, std::span<RigidBody> bodies, std::span<Contact> contacts,
+                    double dt, ResolverCounters& counters);
+  ledas::Island make_island(std::vector<std::uint32_t> rows, std::span<const RigidBody> bodies, double dt);
+  void assign_restitution(ledas::Island& island, std::span<const RigidBody> bodies);
+  const ledas::Vector& current_velocities(ledas::Island& island, std::span<const RigidBody> bodies) const;
+  void velocity_paper(ledas::Island& island, std::span<RigidBody> bodies, ResolverCounters& counters);
+  void velocity_complementary(ledas::Island& island, std::span<RigidBody> bodies, ResolverCounters& counters);
+  void narrow_start_set(const ledas::Island& island, const ledas::Vector& v, std::vector<char>& start);
+  void finish_round(ledas::Island& island, const ledas::Vector& p, const ledas::Vector& target,
+                    std::span<RigidBody> bodies);
+  void report_island(ledas::Island& island, std::span<const RigidBody> bodies, std::span<Contact> contacts,
+                     ResolverCounters& counters);
+  void correct_positions(ledas::Island& island, std::span<RigidBody> bodies);
 
   LedasSettings settings_;
   ledas::IslandSolver solver_;

@@ -1,26 +1,35 @@
 // The paper mode's rounds (sec. 3.2): eq. 6, A_SS p = c_S, as equalities on a subset of an island's
 // rows, each independent block by the cheapest exact method (island_solver.hpp), the minimum-norm
 // least-squares solution where a block is rank-deficient (the paper's Figure 2 and its SVD remark).
-#include "ledas/island_solver.hpp"
-#include "ledas/solver_internal.hpp"
+#include "equality_solver.hpp"
+#include "solver_internal.hpp"
+
+#include <Eigen/SparseCholesky>
 
 #include <algorithm>
 #include <cmath>
 
 namespace impetus::ledas {
 
-Vector IslandSolver::solve_subset(const SparseMatrix& a, const Vector& c, std::span<const RowIndex> subset,
-                                  SolverStats& stats) {
-  Vector p = Vector::Zero(a.rows());
-  solve_subset(a, c, subset, p, stats);
-  return p;
-}
+namespace {
+// Factorizations kept for reuse of their symbolic analysis (distinct sparsity patterns).
+constexpr std::size_t kCacheCapacity = 16;
+}  // namespace
+
+/// A sparse LDLᵀ (Eigen SimplicialLDLT, AMD ordering) with the pattern its symbolic analysis is for.
+struct EqualitySolver::Factor {
+  Eigen::SimplicialLDLT<SparseMatrix, Eigen::Lower, Eigen::AMDOrdering<int>> ldlt;
+  std::vector<int> outer, inner;  // the sparsity pattern the symbolic analysis belongs to
+};
+
+EqualitySolver::EqualitySolver(const SolverSettings& settings) : settings_(settings) {}
+EqualitySolver::~EqualitySolver() = default;
 
 // The subset's rows fall into connected components (rows coupled through A, i.e. through a shared
 // movable body); A_SS is block diagonal in them, so each block is solved on its own by the cheapest
 // exact method. In the paper's rounds most blocks are one or two rows.
-void IslandSolver::solve_subset(const SparseMatrix& a, const Vector& c, std::span<const RowIndex> subset, Vector& p,
-                                SolverStats& stats) {
+void EqualitySolver::solve_subset(const SparseMatrix& a, const Vector& c, std::span<const RowIndex> subset, Vector& p,
+                                  SolverStats& stats) {
   Workspace& w = work_;
   const auto n = static_cast<int>(subset.size());
   if (n == 0) return;
@@ -30,8 +39,20 @@ void IslandSolver::solve_subset(const SparseMatrix& a, const Vector& c, std::spa
     w.slot[subset[static_cast<std::size_t>(i)]] = i;
     w.parent[static_cast<std::size_t>(i)] = i;
   }
-  // Rows coupled to no other row of the subset: closed form at once (p = c / A_11, the single-contact
-  // impulse of the paper's ref. [4]); they leave the component search.
+  if (solve_uncoupled(a, c, subset, p, stats)) {
+    find_components(a, subset);
+    for (int root = 0; root < n; ++root)
+      if (w.parent[static_cast<std::size_t>(root)] == root) solve_component(a, c, subset, root, p, stats);
+  }
+  for (RowIndex k : subset) w.slot[k] = -1;
+}
+
+// Rows coupled to no other row of the subset: closed form at once (p = c / A_11, the single-contact
+// impulse of the paper's ref. [4]); they leave the component search.
+bool EqualitySolver::solve_uncoupled(const SparseMatrix& a, const Vector& c, std::span<const RowIndex> subset,
+                                     Vector& p, SolverStats& stats) {
+  Workspace& w = work_;
+  const auto n = static_cast<int>(subset.size());
   bool coupled = false;
   for (int i = 0; i < n; ++i) {
     const RowIndex k = subset[static_cast<std::size_t>(i)];
@@ -54,10 +75,14 @@ void IslandSolver::solve_subset(const SparseMatrix& a, const Vector& c, std::spa
     }
     w.parent[static_cast<std::size_t>(i)] = -1;
   }
-  if (!coupled) {
-    for (RowIndex k : subset) w.slot[k] = -1;
-    return;
-  }
+  return coupled;
+}
+
+// Union-find over the coupled rows; members of each component in increasing order, components by their
+// first row (deterministic).
+void EqualitySolver::find_components(const SparseMatrix& a, std::span<const RowIndex> subset) {
+  Workspace& w = work_;
+  const auto n = static_cast<int>(subset.size());
   const auto find = [&](int x) {
     while (w.parent[static_cast<std::size_t>(x)] != x)
       x = w.parent[static_cast<std::size_t>(x)] = w.parent[static_cast<std::size_t>(w.parent[static_cast<std::size_t>(x)])];
@@ -65,12 +90,11 @@ void IslandSolver::solve_subset(const SparseMatrix& a, const Vector& c, std::spa
   };
   for (int i = 0; i < n; ++i)
     if (w.parent[static_cast<std::size_t>(i)] >= 0)
-    for (SparseMatrix::InnerIterator it(a, subset[static_cast<std::size_t>(i)]); it; ++it)
-      if (const int j = w.slot[static_cast<std::size_t>(it.row())]; j >= 0) {
-        const int ri = find(i), rj = find(j);
-        if (ri != rj) w.parent[static_cast<std::size_t>(std::max(ri, rj))] = std::min(ri, rj);
-      }
-  // Members of each component in increasing order, components by their first row (deterministic).
+      for (SparseMatrix::InnerIterator it(a, subset[static_cast<std::size_t>(i)]); it; ++it)
+        if (const int j = w.slot[static_cast<std::size_t>(it.row())]; j >= 0) {
+          const int ri = find(i), rj = find(j);
+          if (ri != rj) w.parent[static_cast<std::size_t>(std::max(ri, rj))] = std::min(ri, rj);
+        }
   w.start.assign(subset.size() + 1, 0);
   for (int i = 0; i < n; ++i)
     if (w.parent[static_cast<std::size_t>(i)] >= 0) ++w.start[static_cast<std::size_t>(find(i)) + 1];
@@ -79,34 +103,34 @@ void IslandSolver::solve_subset(const SparseMatrix& a, const Vector& c, std::spa
   w.fill.assign(w.start.begin(), w.start.end() - 1);
   for (int i = 0; i < n; ++i)
     if (w.parent[static_cast<std::size_t>(i)] >= 0) w.members[static_cast<std::size_t>(w.fill[static_cast<std::size_t>(w.parent[static_cast<std::size_t>(i)])]++)] = i;
+}
 
-  for (int root = 0; root < n; ++root) {
-    if (w.parent[static_cast<std::size_t>(root)] != root) continue;
-    const int begin = w.start[static_cast<std::size_t>(root)], size = w.start[static_cast<std::size_t>(root) + 1] - begin;
-    const auto row = [&](int local) { return subset[static_cast<std::size_t>(w.members[static_cast<std::size_t>(begin + local)])]; };
-    for (int i = 0; i < size; ++i) w.slot[row(i)] = i;  // now: position within the component
-    if (static_cast<std::size_t>(size) <= settings_.dense_limit) {
-      w.dense.setZero(size, size);
-      w.rhs.resize(size);
-      for (int j = 0; j < size; ++j) {
-        w.rhs(j) = c(row(j));
-        for (SparseMatrix::InnerIterator it(a, row(j)); it; ++it)
-          if (const int i = w.slot[static_cast<std::size_t>(it.row())]; i >= 0) w.dense(i, j) = it.value();
-      }
-      const Vector part = solve_dense_matrix(w.dense, w.rhs, stats);
-      for (int i = 0; i < size; ++i) p(row(i)) = part(i);
-    } else {
-      std::vector<RowIndex> rows(static_cast<std::size_t>(size));
-      for (int i = 0; i < size; ++i) rows[static_cast<std::size_t>(i)] = row(i);
-      const Vector part = solve_system(principal_submatrix(a, rows), gather(c, rows), stats);
-      for (int i = 0; i < size; ++i) p(row(i)) = part(i);
+void EqualitySolver::solve_component(const SparseMatrix& a, const Vector& c, std::span<const RowIndex> subset,
+                                     int root, Vector& p, SolverStats& stats) {
+  Workspace& w = work_;
+  const int begin = w.start[static_cast<std::size_t>(root)], size = w.start[static_cast<std::size_t>(root) + 1] - begin;
+  const auto row = [&](int local) { return subset[static_cast<std::size_t>(w.members[static_cast<std::size_t>(begin + local)])]; };
+  for (int i = 0; i < size; ++i) w.slot[row(i)] = i;  // now: position within the component
+  if (static_cast<std::size_t>(size) <= settings_.dense_limit) {
+    w.dense.setZero(size, size);
+    w.rhs.resize(size);
+    for (int j = 0; j < size; ++j) {
+      w.rhs(j) = c(row(j));
+      for (SparseMatrix::InnerIterator it(a, row(j)); it; ++it)
+        if (const int i = w.slot[static_cast<std::size_t>(it.row())]; i >= 0) w.dense(i, j) = it.value();
     }
+    const Vector part = solve_dense_matrix(w.dense, w.rhs, stats);
+    for (int i = 0; i < size; ++i) p(row(i)) = part(i);
+  } else {
+    std::vector<RowIndex> rows(static_cast<std::size_t>(size));
+    for (int i = 0; i < size; ++i) rows[static_cast<std::size_t>(i)] = row(i);
+    const Vector part = solve_system(principal_submatrix(a, rows), gather(c, rows), stats);
+    for (int i = 0; i < size; ++i) p(row(i)) = part(i);
   }
-  for (RowIndex k : subset) w.slot[k] = -1;
 }
 
 // Chooses the cheapest exact method for one system (see the header).
-Vector IslandSolver::solve_system(const SparseMatrix& m, const Vector& rhs, SolverStats& stats) {
+Vector EqualitySolver::solve_system(const SparseMatrix& m, const Vector& rhs, SolverStats& stats) {
   const Eigen::Index n = m.rows();
   if (n == 0) return Vector();
   const double scale = Vector(m.diagonal()).maxCoeff();
@@ -126,7 +150,7 @@ Vector IslandSolver::solve_system(const SparseMatrix& m, const Vector& rhs, Solv
   return solve_sparse(m, rhs, pivot_floor, stats);
 }
 
-Vector IslandSolver::solve_dense_matrix(const Eigen::MatrixXd& a, const Vector& rhs, SolverStats& stats) {
+Vector EqualitySolver::solve_dense_matrix(const Eigen::MatrixXd& a, const Vector& rhs, SolverStats& stats) {
   ++stats.dense;
   const double scale = a.diagonal().maxCoeff();
   if (!(scale > 0.0) || !std::isfinite(scale)) {  // no movable body behind any row
@@ -154,7 +178,7 @@ Eigen::MatrixXd orthonormal_columns(const Eigen::MatrixXd& x) {
 }
 }  // namespace
 
-Vector IslandSolver::solve_sparse(const SparseMatrix& m, const Vector& rhs, double pivot_floor,
+Vector EqualitySolver::solve_sparse(const SparseMatrix& m, const Vector& rhs, double pivot_floor,
                                   SolverStats& stats) {
   ++stats.sparse;
   FactorPtr f = checkout(m, stats);
@@ -208,6 +232,34 @@ Vector IslandSolver::solve_sparse(const SparseMatrix& m, const Vector& rhs, doub
   }
   checkin(f);
   return p;
+}
+
+EqualitySolver::FactorPtr EqualitySolver::checkout(const SparseMatrix& m, SolverStats& stats) {
+  const auto same_pattern = [&](const Factor& f) {
+    return f.outer.size() == static_cast<std::size_t>(m.cols()) + 1 &&
+           f.inner.size() == static_cast<std::size_t>(m.nonZeros()) &&
+           std::equal(f.outer.begin(), f.outer.end(), m.outerIndexPtr()) &&
+           std::equal(f.inner.begin(), f.inner.end(), m.innerIndexPtr());
+  };
+  for (auto it = cache_.begin(); it != cache_.end(); ++it) {
+    if (same_pattern(**it)) {
+      FactorPtr f = *it;
+      cache_.erase(it);
+      ++stats.symbolic_reused;
+      return f;
+    }
+  }
+  auto f = std::make_shared<Factor>();
+  f->ldlt.analyzePattern(m);
+  f->outer.assign(m.outerIndexPtr(), m.outerIndexPtr() + m.cols() + 1);
+  f->inner.assign(m.innerIndexPtr(), m.innerIndexPtr() + m.nonZeros());
+  ++stats.symbolic_analyses;
+  return f;
+}
+
+void EqualitySolver::checkin(FactorPtr factor) {
+  cache_.push_back(std::move(factor));  // most recently used last
+  if (cache_.size() > kCacheCapacity) cache_.erase(cache_.begin());
 }
 
 }  // namespace impetus::ledas

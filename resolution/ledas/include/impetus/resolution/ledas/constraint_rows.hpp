@@ -19,8 +19,8 @@
 ///    curvature (½ (ω dt)² r per step) leaves with the first-order form. Eq. 9's factor dt multiplies
 ///    a whole row of A and b and is divided out, keeping A symmetric.
 
-#include "common/impulse_rows.hpp"
 #include "impetus/modules/constraint.hpp"
+#include "impetus/resolution/common/impulse_rows.hpp"
 
 #include <cstdint>
 #include <span>
@@ -29,9 +29,8 @@
 
 namespace impetus::ledas {
 
-/// What the system needs about a row beyond its algebra.
+/// What the system needs about a row beyond its algebra (resolution::ImpulseRow): its kind and target.
 struct RowInfo {
-  Vec3 point_b = Vec3::Zero();  ///< where the impulse acts on body b (world, m); a contact's point
   double depth = 0.0;           ///< contact penetration (m): > 0 overlap, < 0 gap; 0 for a joint row
   double target = 0.0;          ///< joint rows: the wanted v_n⁺ (m/s): 0, or v_n⁻ − s⁺/dt (see the file comment)
   bool equality = false;        ///< a joint row: impulse of either sign, never released, e = 0
@@ -39,18 +38,9 @@ struct RowInfo {
   std::int64_t contact = -1;    ///< index of the row's contact, or −1 for a joint row
 };
 
-/// The row's relative normal velocity (u_b(point_b) − u_a(point))·n (m/s, < 0 approaches), u = v + ω×r.
-/// For a contact (point_b = point) it is resolution::row_velocity. Inline: evaluated for every row twice
-/// per round.
-inline double row_velocity(const resolution::ImpulseRow& row, const RowInfo& info, std::span<const RigidBody> bodies) {
-  return (bodies[row.b].velocity_at(info.point_b) - bodies[row.a].velocity_at(row.point))
-      .dot(row.normal);
-}
-
 /// A position-level joint row's separation s⁺ (m, along the row) after a step of `dt` at the bodies'
 /// current velocities, the bodies moved as eq. 2 moves them (x += dt v, R = Q(ω dt) R).
-double predicted_separation(const resolution::ImpulseRow& row, const RowInfo& info,
-                            std::span<const RigidBody> bodies, double dt);
+double predicted_separation(const resolution::ImpulseRow& row, std::span<const RigidBody> bodies, double dt);
 
 /// Appends the rows of `constraint` at the bodies' current poses for a step of `dt` (s), the bodies' J⁻¹
 /// from `inertia` (reset for `bodies`):

@@ -1,0 +1,101 @@
+// The complementary mode: each round solves the exact inelastic impact (a linear complementarity
+// problem over the approaching and touching rows, island_solver.hpp), then applies (1 + e) p.
+#include "island.hpp"
+#include "impetus/resolution/ledas/ledas.hpp"
+
+#include <cmath>
+
+namespace impetus {
+
+using ledas::Vector;
+// The exact impact (a linear complementarity problem), then (1 + e) p. Restitution can make a contact
+// approach again (a separating contact pushed shut gets −e v_n⁻), so the round repeats while any does.
+void LedasResolver::velocity_complementary(ledas::Island& island, std::span<RigidBody> bodies, ResolverCounters& counters) {
+  const std::size_t m = island.rows.size();
+  ledas::ComplementarityProblem problem;
+  problem.matrix = &island.a;
+  problem.equality = island.equality;
+  problem.start.resize(m);
+  problem.tolerance = settings_.tolerance;
+  for (std::uint64_t round = 0;; ++round) {
+    const Vector& v = current_velocities(island, bodies);  // (finish_round changes it: not used after)
+    bool needed = ledas::retarget_joints(island, rows_, info_, v, bodies) && round > 0;
+    Vector target = island.target;
+    for (std::size_t i = 0; i < m; ++i) {
+      const auto ei = static_cast<Eigen::Index>(i);
+      if (island.equality[i]) {
+        problem.start[i] = 1;
+        needed = needed || (round == 0 && std::abs(v(ei) - island.target(ei)) > settings_.tolerance);
+        continue;
+      }
+      const bool touching = v(ei) <= island.target(ei) + settings_.tolerance;  // approaching or touching
+      problem.start[i] = touching;
+      needed = needed || v(ei) < island.target(ei) - settings_.tolerance;
+      target(ei) = ledas::solve_target(island.target(ei), touching, island.restitution(ei));
+      if (touching) island.entered[i] = 1;
+    }
+    if (!needed) break;
+    if (round == settings_.max_rounds) {
+      ++counters.non_converged;
+      break;
+    }
+    if (settings_.start_set == LedasStartSet::impact) narrow_start_set(island, v, problem.start);
+    problem.rhs = target - v;
+    const std::uint64_t before = stats_.velocity.iterations;
+    const Vector p = solver_.solve_complementarity(problem, stats_.velocity);
+    stats_.systems += stats_.velocity.iterations - before;
+    for (std::size_t i = 0; i < m; ++i)
+      if (p(static_cast<Eigen::Index>(i)) != 0.0) island.entered[i] = 1;
+    finish_round(island, p, target, bodies);
+    ++island.rounds;
+  }
+}
+
+// The complementary mode's start set (README.md, "The start set"): of the touching contacts, only those
+// that can pass the impact on. The impact's sources are the movable bodies of the approaching contacts
+// and of the joint rows off their target; every movable body's distance from them is counted in hops
+// over the rows of the start set (breadth-first). A touching contact between two movable bodies at the
+// same distance runs across the front along which the impact travels: the bodies behind a front are
+// pushed apart along it, not together (a pyramid's horizontal contacts, boxes side by side on a floor),
+// so such a contact almost always separates. Started in, it is a redundant row the first solve must
+// factorize (a pyramid's horizontal contacts carry most of the factorization's fill) and the search
+// must then release; left out, it joins at the next iteration if it would approach. Contacts with a
+// fixed body and contacts between bodies the impact does not reach keep their places (in; out: nothing
+// pushes them).
+void LedasResolver::narrow_start_set(const ledas::Island& island, const Vector& v, std::vector<char>& start) {
+  const std::size_t m = island.rows.size();
+  const auto& slots = island.incidence.slots;
+  const auto driving = [&](std::size_t i) {
+    const auto ei = static_cast<Eigen::Index>(i);
+    return island.equality[i] ? std::abs(v(ei) - island.target(ei)) > settings_.tolerance
+                              : v(ei) < island.target(ei) - settings_.tolerance;
+  };
+  hops_.assign(island.bodies.size(), -1);
+  queue_.clear();
+  for (std::size_t i = 0; i < m; ++i)
+    if (driving(i))
+      for (const std::int32_t s : slots[i])
+        if (s >= 0 && hops_[static_cast<std::size_t>(s)] < 0) {
+          hops_[static_cast<std::size_t>(s)] = 0;
+          queue_.push_back(s);
+        }
+  for (std::size_t head = 0; head < queue_.size(); ++head) {
+    const std::int32_t s = queue_[head];
+    for (const std::uint32_t i : island.incidence.rows_of(s)) {
+      if (!start[i]) continue;
+      const std::int32_t other = slots[i][0] == s ? slots[i][1] : slots[i][0];
+      if (other >= 0 && hops_[static_cast<std::size_t>(other)] < 0) {
+        hops_[static_cast<std::size_t>(other)] = hops_[static_cast<std::size_t>(s)] + 1;
+        queue_.push_back(other);
+      }
+    }
+  }
+  for (std::size_t i = 0; i < m; ++i) {
+    const std::int32_t a = slots[i][0], b = slots[i][1];
+    if (start[i] && !island.equality[i] && a >= 0 && b >= 0 &&
+        hops_[static_cast<std::size_t>(a)] == hops_[static_cast<std::size_t>(b)] && !driving(i))
+      start[i] = 0;
+  }
+}
+
+}  // namespace impetus

@@ -1,0 +1,72 @@
+#pragma once
+/// \file
+/// One island's working data inside the LEDAS resolver (private: not installed, not for tests): its rows
+/// (local row i is the resolver's row rows[i]), A of eq. 7 over them, targets, restitution and the
+/// impulses accumulated over the rounds.
+
+#include "impetus/core/body.hpp"
+#include "impetus/resolution/common/impulse_rows.hpp"
+#include "impetus/resolution/common/incidence.hpp"
+#include "impetus/resolution/ledas/constraint_rows.hpp"
+#include "impetus/resolution/ledas/island_solver.hpp"
+
+#include <cstdint>
+#include <limits>
+#include <span>
+#include <vector>
+
+namespace impetus::ledas {
+
+/// Relative rounding below which a negative impulse is not counted as pulling, and an energy rise not
+/// counted as a gain.
+inline constexpr double kRoundoff = 1e-12;
+
+/// One island's working data.
+struct Island {
+  std::vector<std::uint32_t> rows;    ///< the resolver's rows, increasing
+  SparseMatrix a;                     ///< A of eq. 7 over the rows (both triangles)
+  std::vector<BodyIndex> bodies;      ///< movable bodies, increasing (their slots in `incidence`)
+  resolution::Incidence incidence;    ///< rows ↔ movable bodies
+  std::vector<char> equality;         ///< joint rows
+  Vector target;                      ///< v_n⁺ bound (m/s): min(0, depth)/dt for contacts, RowInfo::target for joints
+  Vector restitution;                 ///< effective e per row (0 for joint rows)
+  Vector impulse_inelastic;           ///< Σ p over rounds (N·s)
+  Vector impulse_total;               ///< Σ (1 + e) p over rounds (N·s)
+  std::vector<char> entered;          ///< the row took part in a system
+  double complementarity = 0.0;       ///< max |Σ p · (v_n − target)| after the last inelastic phase
+  std::uint64_t rounds = 0;
+  double dt = 0.0;                    ///< the step (s)
+  double joint_gap = std::numeric_limits<double>::infinity();  ///< last predicted position-joint gap (m)
+
+  /// Every row's v_n at the bodies' velocities, valid while `velocity_current` (cleared by whatever
+  /// changes the island's body velocities without recomputing it).
+  Vector velocity;
+  bool velocity_current = false;
+
+  /// Sets `complementarity` = max over contact rows of |Σ p · (v_n − target)| at velocities v (after an
+  /// inelastic phase).
+  void measure_complementarity(const Vector& v, const Vector& target_now);
+  /// Whether any row bounces (e > 0).
+  bool bouncing() const { return restitution.size() > 0 && restitution.maxCoeff() > 0.0; }
+};
+
+/// A of eq. 7 over the rows `island` of `rows` (local indices), both triangles stored, exactly symmetric.
+SparseMatrix assemble_matrix(std::span<const resolution::ImpulseRow> rows, std::span<const std::uint32_t> island,
+                             const resolution::Incidence& incidence);
+
+/// Kinetic energy of the bodies `which` (J).
+double kinetic_energy(std::span<const RigidBody> bodies, std::span<const BodyIndex> which);
+
+/// Sets the target of the island's position-level joint rows (eqs. 9–10) from the gap predicted at the
+/// rows' velocities v (m/s); returns whether another round is worth it (the gap, in m, is above 1e-9 and
+/// fell by half at least since the last call).
+bool retarget_joints(Island& island, std::span<const resolution::ImpulseRow> rows, std::span<const RowInfo> info,
+                     const Vector& v, std::span<const RigidBody> bodies);
+
+/// The target a row is solved for this round. A gap contact that closes within the step and bounces
+/// (e > 0) is an impact now: target 0, so (1 + e) p returns its full energy.
+inline double solve_target(double base_target, bool closing, double restitution) {
+  return closing && restitution > 0.0 ? 0.0 : base_target;
+}
+
+}  // namespace impetus::ledas
