@@ -70,16 +70,9 @@ ImpulseRow make_contact_row(std::span<const RigidBody> bodies, InverseInertiaCac
 }
 
 void apply_row_impulse(const ImpulseRow& row, double p, std::span<RigidBody> bodies) {
-  RigidBody& a = bodies[row.a];
-  RigidBody& b = bodies[row.b];
-  if (!a.fixed) {
-    a.velocity -= (p * row.inv_mass_a) * row.normal;
-    a.angular_velocity -= p * row.turn_a;
-  }
-  if (!b.fixed) {
-    b.velocity += (p * row.inv_mass_b) * row.normal;
-    b.angular_velocity += p * row.turn_b;
-  }
+  // Eq. 3 with the row's J⁻¹ (r × n) (turn_a, turn_b) computed once when the row was built.
+  apply_normal_impulse(bodies[row.a], -p, row.normal, row.turn_a);
+  apply_normal_impulse(bodies[row.b], p, row.normal, row.turn_b);
 }
 
 std::vector<std::vector<std::uint32_t>> find_islands(std::span<const ImpulseRow> rows,

@@ -20,6 +20,9 @@ import subprocess
 import sys
 
 INCLUDE = re.compile(r'^\s*#\s*include\s*[<"](impetus/[^>"]+)[>"]')
+# A quoted include with a folder that is not impetus/…: ambiguous (which `common/`?) and shadowing
+# (a plugin folder on the include path hides a library's own folder of the same name).
+QUOTED_PATH = re.compile(r'^\s*#\s*include\s*"((?!impetus/)[^"]*/[^"]*)"')
 SOURCE_SUFFIXES = ('.cpp', '.hpp', '.h', '.cc')
 # Parts of the repository that use the engine from the outside: they may include any layer.
 CLIENTS = ('tests/', 'benchmarks/', 'fuzz/', 'examples/')
@@ -101,6 +104,10 @@ def check_layers(root):
         allowed = set(layers[own][2]) | {own}
         with open(os.path.join(root, rel), encoding='utf-8', errors='replace') as f:
             for number, line in enumerate(f, 1):
+                local = QUOTED_PATH.match(line)
+                if local:
+                    failures.append(f'{rel}:{number}: "{local.group(1)}": include project headers as '
+                                    f'"impetus/…" (a private header beside the source by its file name)')
                 m = INCLUDE.match(line)
                 if not m:
                     continue

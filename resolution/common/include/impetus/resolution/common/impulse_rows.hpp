@@ -103,7 +103,7 @@ inline double self_coupling(const ImpulseRow& row) { return coupling(row, row); 
 /// v_n = (u_b(point_b) − u_a(point))·n of the row at the bodies' current velocities, u = v + ω × r
 /// (eq. 5; m/s, < 0 approaches). Inline: evaluated for every row after every round.
 inline double row_velocity(const ImpulseRow& row, std::span<const RigidBody> bodies) {
-  return (bodies[row.b].velocity_at(row.point_b) - bodies[row.a].velocity_at(row.point)).dot(row.normal);
+  return relative_normal_velocity(bodies[row.a], row.point, bodies[row.b], row.point_b, row.normal);
 }
 
 /// Body a's share of the row's v_n in Jacobian form, n·v_a + (r_a×n)·ω_a (m/s; eq. 5 with
