@@ -9,24 +9,6 @@
 namespace impetus::conformance {
 namespace {
 
-/// Runs `steps` full steps from step index 0; returns the summed counters.
-IntegratorCounters run(Integrator& integrator, std::vector<RigidBody>& bodies, StepContext ctx, int steps) {
-  IntegratorCounters total;
-  for (int i = 0; i < steps; ++i) {
-    ctx.step = static_cast<std::uint64_t>(i);
-    ctx.time = i * ctx.dt;
-    integrator.integrate_velocities(bodies, ctx, total);
-    integrator.integrate_positions(bodies, ctx, total);
-  }
-  return total;
-}
-
-/// Rotation angle (rad) of R_aᵀ R_b, accurate near zero.
-double angle_between(const Mat3& r_a, const Mat3& r_b) {
-  const Quat q(Mat3(r_a.transpose() * r_b));
-  return 2.0 * std::atan2(q.vec().norm(), std::abs(q.w()));
-}
-
 /// A torque-free body with principal moments (1, 2, 3) spun near its intermediate axis, gravity off:
 /// the true motion tumbles while L stays fixed in the world.
 std::vector<RigidBody> tumbling_body() {

@@ -59,59 +59,6 @@ std::string unknown_option_message(const PluginUnderTest& plugin, ModuleKind kin
   return {};
 }
 
-RigidBody sphere(double mass, double radius, const Vec3& position, const Vec3& velocity, double restitution) {
-  RigidBody b;
-  b.shape = Sphere{radius};
-  b.mass = mass;
-  b.inv_mass = 1.0 / mass;
-  b.inertia_body = Mat3::Identity() * (0.4 * mass * radius * radius);
-  b.inv_inertia_body = b.inertia_body.inverse();
-  b.position = position;
-  b.velocity = velocity;
-  b.material.restitution = restitution;
-  return b;
-}
-
-RigidBody box(double mass, const Vec3& size, const Vec3& position, const Mat3& rotation, const Vec3& velocity,
-              double restitution) {
-  const Vec3 s2 = size.cwiseProduct(size);
-  RigidBody b = principal_body(mass, mass / 12.0 * Vec3(s2.y() + s2.z(), s2.x() + s2.z(), s2.x() + s2.y()));
-  b.shape = Box{size};
-  b.position = position;
-  b.rotation = rotation;
-  b.velocity = velocity;
-  b.material.restitution = restitution;
-  return b;
-}
-
-RigidBody principal_body(double mass, const Vec3& moments) {
-  RigidBody b;
-  b.mass = mass;
-  b.inv_mass = 1.0 / mass;
-  b.inertia_body = moments.asDiagonal();
-  b.inv_inertia_body = moments.cwiseInverse().asDiagonal();
-  return b;
-}
-
-RigidBody ground(double restitution) {
-  RigidBody g;
-  g.name = "ground";
-  g.shape = Plane{Vec3::UnitZ(), 0.0};
-  make_fixed(g);
-  g.material.restitution = restitution;
-  return g;
-}
-
-Contact contact(BodyIndex a, BodyIndex b, const Vec3& point, const Vec3& normal, double depth) {
-  Contact c;
-  c.a = a;
-  c.b = b;
-  c.point = point;
-  c.normal = normal.normalized();
-  c.depth = depth;
-  return c;
-}
-
 Vec3 linear_momentum(std::span<const RigidBody> bodies) {
   Vec3 p = Vec3::Zero();
   for (const RigidBody& b : bodies)
@@ -133,7 +80,5 @@ double kinetic_energy(std::span<const RigidBody> bodies) {
       e += 0.5 * b.mass * b.velocity.squaredNorm() + 0.5 * b.angular_velocity.dot(b.inertia_world() * b.angular_velocity);
   return e;
 }
-
-double orthonormality_error(const Mat3& rotation) { return (rotation.transpose() * rotation - Mat3::Identity()).norm(); }
 
 }  // namespace impetus::conformance

@@ -16,39 +16,9 @@
 
 namespace impetus::mirtich_test {
 
-/// A movable sphere of `mass` (kg) and `radius` (m) at `position` moving with `velocity`.
-inline RigidBody sphere(double mass, double radius, const Vec3& position, const Vec3& velocity,
-                        double restitution = 0.0) {
-  RigidBody b;
-  b.shape = Sphere{radius};
-  b.mass = mass;
-  b.inv_mass = 1.0 / mass;
-  b.inertia_body = Mat3::Identity() * (0.4 * mass * radius * radius);
-  b.inv_inertia_body = b.inertia_body.inverse();
-  b.position = position;
-  b.velocity = velocity;
-  b.material.restitution = restitution;
-  return b;
-}
-
-/// A movable box with full edges `size` (m): inertia m/12 (b² + c², …) about its axes.
-inline RigidBody box(double mass, const Vec3& size, const Vec3& position, const Mat3& rotation,
-                     const Vec3& velocity, double restitution = 0.0) {
-  RigidBody b;
-  b.shape = Box{size};
-  b.mass = mass;
-  b.inv_mass = 1.0 / mass;
-  const Vec3 s2 = size.cwiseProduct(size);
-  b.inertia_body = (mass / 12.0 * Vec3(s2.y() + s2.z(), s2.x() + s2.z(), s2.x() + s2.y())).asDiagonal();
-  b.inv_inertia_body = b.inertia_body.inverse();
-  b.position = position;
-  b.rotation = rotation;
-  b.velocity = velocity;
-  b.material.restitution = restitution;
-  return b;
-}
-
-/// The fixed ground (z ≤ 0) and hand-written contacts.
+/// Hand-built spheres, boxes, the fixed ground (z ≤ 0) and contacts (impetus/conformance/fixtures.hpp).
+using conformance::box;
+using conformance::sphere;
 inline RigidBody ground() { return test::ground_plane(); }
 using test::contact;
 

@@ -8,6 +8,7 @@
 ///
 /// Test-only code: it uses GoogleTest and throws impetus::Error through the host on a load failure.
 
+#include "impetus/conformance/fixtures.hpp"
 #include "impetus/core/body.hpp"
 #include "impetus/core/math.hpp"
 #include "impetus/core/shape.hpp"
@@ -72,18 +73,7 @@ std::string unknown_option_message(const PluginUnderTest& plugin, ModuleKind kin
 
 // --- bodies, built without the engine (mass properties in closed form) ---
 
-/// A movable solid sphere: mass m (kg), radius r (m), inertia 2/5 m r².
-RigidBody sphere(double mass, double radius, const Vec3& position, const Vec3& velocity = Vec3::Zero(),
-                 double restitution = 0.0);
-/// A movable solid box with full edges `size` (m): inertia m/12 (b² + c², …) about its axes.
-RigidBody box(double mass, const Vec3& size, const Vec3& position, const Mat3& rotation = Mat3::Identity(),
-              const Vec3& velocity = Vec3::Zero(), double restitution = 0.0);
-/// A movable body of mass m with principal moments `moments` along its body axes (no shape needed).
-RigidBody principal_body(double mass, const Vec3& moments);
-/// The fixed half-space z ≤ 0, its body at the origin.
-RigidBody ground(double restitution = 0.0);
-/// A contact following the convention (normal normalized here, out of a into b).
-Contact contact(BodyIndex a, BodyIndex b, const Vec3& point, const Vec3& normal, double depth = 0.0);
+// Bodies and contacts built by hand: impetus/conformance/fixtures.hpp.
 
 // --- measures of the movable bodies (fixed bodies carry none) ---
 
@@ -93,8 +83,6 @@ Vec3 linear_momentum(std::span<const RigidBody> bodies);
 Vec3 angular_momentum(std::span<const RigidBody> bodies);
 /// Σ ½ m v² + ½ ωᵀ J_world ω (J).
 double kinetic_energy(std::span<const RigidBody> bodies);
-/// ‖RᵀR − I‖ (Frobenius).
-double orthonormality_error(const Mat3& rotation);
 
 /// The resolver suite. Tests: see resolver_suite.cpp.
 class ResolverConformance : public ::testing::TestWithParam<PluginUnderTest> {};
