@@ -54,6 +54,10 @@ void RunStats::add_step(const World& world, const StepStatus& status) {
   singular_ += status.resolver.singular_systems;
   pulling_ += status.resolver.pulling_impulses;
   energy_gains_ += status.resolver.energy_gain_events;
+  sticking_ += status.resolver.sticking;
+  sliding_ += status.resolver.sliding;
+  friction_work_ += status.resolver.friction_work;
+  max_natural_map_ = std::max(max_natural_map_, status.resolver.natural_map_residual);
   max_residual_ = std::max(max_residual_, status.resolver.residual);
   for (const Contact& c : world.contacts()) max_penetration_ = std::max(max_penetration_, c.depth);
 }
@@ -81,7 +85,11 @@ json RunStats::summary(const World& world, double wall_seconds) const {
         {"singular_systems", singular_},
         {"pulling_impulses", pulling_},
         {"energy_gain_events", energy_gains_},
-        {"max_residual_m_per_s", max_residual_}}},
+        {"max_residual_m_per_s", max_residual_},
+        {"max_natural_map_residual", max_natural_map_}}},
+      {"friction",
+       {{"sticking_contacts", sticking_}, {"sliding_contacts", sliding_},
+        {"dissipated_j", -friction_work_}}},
       {"energy",
        {{"initial_j", e0}, {"final_j", e1}, {"drift_j", e1 - e0},
         {"kinetic_final_j", now.kinetic_energy}}},
@@ -111,6 +119,10 @@ void print_summary(const json& s, std::ostream& out) {
       << " non-converged, " << r["singular_systems"].get<std::uint64_t>() << " singular, "
       << r["energy_gain_events"].get<std::uint64_t>() << " energy gains, max residual "
       << r["max_residual_m_per_s"].get<double>() << " m/s\n"
+      << "friction              " << s["friction"]["sticking_contacts"].get<std::uint64_t>() << " sticking and "
+      << s["friction"]["sliding_contacts"].get<std::uint64_t>() << " sliding contacts (summed over steps), "
+      << s["friction"]["dissipated_j"].get<double>() << " J dissipated, max natural-map residual "
+      << r["max_natural_map_residual"].get<double>() << "\n"
       << "energy                " << e["initial_j"].get<double>() << " J -> " << e["final_j"].get<double>()
       << " J (drift " << e["drift_j"].get<double>() << " J)\n"
       << "momentum drift        linear " << s["linear_momentum_drift"].get<double>() << " kg m/s, angular "
@@ -155,7 +167,8 @@ json resolve_report(const World& world, const std::string& resolver, double seco
   json contacts = json::array();
   for (const Contact& c : world.contacts())
     contacts.push_back({{"a", bodies[c.a].name}, {"b", bodies[c.b].name}, {"point", vec(c.point)},
-                        {"normal", vec(c.normal)}, {"depth", c.depth}, {"impulse", c.impulse}});
+                        {"normal", vec(c.normal)}, {"depth", c.depth}, {"impulse", c.impulse},
+                        {"tangent_impulse", vec(c.tangent_impulse)}, {"mode", contact_mode_name(c.mode)}});
   json out_bodies = json::array();
   for (const RigidBody& b : bodies)
     out_bodies.push_back({{"name", b.name}, {"velocity", vec(b.velocity)},
@@ -168,6 +181,10 @@ json resolve_report(const World& world, const std::string& resolver, double seco
               {"pulling_impulses", s.resolver.pulling_impulses},
               {"singular_systems", s.resolver.singular_systems},
               {"energy_gain_events", s.resolver.energy_gain_events},
+              {"natural_map_residual", s.resolver.natural_map_residual},
+              {"sticking", s.resolver.sticking},
+              {"sliding", s.resolver.sliding},
+              {"friction_work_j", s.resolver.friction_work},
               {"contacts", contacts},
               {"bodies", out_bodies}};
 }

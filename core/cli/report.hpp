@@ -36,6 +36,8 @@ class RunStats {
   StepProfile time_;                     // summed over steps
   std::uint64_t steps_ = 0, contacts_ = 0, max_contacts_ = 0, rounds_ = 0, max_rounds_ = 0;
   std::uint64_t non_converged_ = 0, singular_ = 0, pulling_ = 0, energy_gains_ = 0;
+  std::uint64_t sticking_ = 0, sliding_ = 0;
+  double friction_work_ = 0.0, max_natural_map_ = 0.0;
   double max_penetration_ = 0.0, max_residual_ = 0.0;
 };
 

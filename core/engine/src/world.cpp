@@ -35,6 +35,10 @@ void validate_body(const RigidBody& body, std::size_t index) {
   if (!((body.rotation.transpose() * body.rotation - Mat3::Identity()).norm() < 1e-9) ||
       !(body.rotation.determinant() > 0.0))
     throw Error(label + ": rotation is not a proper rotation matrix");
+  if (!std::isfinite(body.material.friction) || body.material.friction < 0.0)
+    throw Error(label + ": friction must be finite and >= 0, got " + std::to_string(body.material.friction));
+  if (!std::isfinite(body.material.restitution) || body.material.restitution < 0.0)
+    throw Error(label + ": restitution must be finite and >= 0, got " + std::to_string(body.material.restitution));
   if (std::holds_alternative<Plane>(body.shape) && !body.fixed)
     throw Error(label + ": a plane is an infinite half-space and must be fixed");
   if (body.fixed) return;
@@ -56,6 +60,15 @@ ConstraintEnds ends_of(const Constraint& constraint) {
   return std::visit([](const auto& c) { return ConstraintEnds{c.a, c.b, c.collide}; }, constraint);
 }
 
+// Refuses a resolver that does not model friction when `body` has friction (the resolver says why).
+void check_friction(CollisionResolver& resolver, const RigidBody& body, std::size_t index) {
+  if (!(body.material.friction > 0.0)) return;
+  if (ModuleStatus s = resolver.accept_friction(); !s)
+    throw Error("resolver: " + s.message + ", but " + body_label(body, index) + " has friction " +
+                std::to_string(body.material.friction) +
+                "; choose a resolver that models friction (ledas, mirtich) or set its friction to 0");
+}
+
 }  // namespace
 
 World::World(WorldSettings settings) : settings_(std::move(settings)) {
@@ -70,6 +83,7 @@ BodyIndex World::add_body(RigidBody body) {
   validate_body(body, bodies_.size());
   if (!body.name.empty() && find_body(body.name))
     throw Error("body '" + body.name + "': a body with this name already exists");
+  if (resolver_) check_friction(*resolver_, body, bodies_.size());
   if (body.fixed) make_fixed(body);
   bodies_.push_back(std::move(body));
   detector_stale_ = true;
@@ -103,6 +117,7 @@ void World::set_detector(std::shared_ptr<CollisionDetector> detector) {
 void World::set_resolver(std::shared_ptr<CollisionResolver> resolver) {
   if (resolver) {
     if (ModuleStatus s = resolver->accept_constraints(constraints_); !s) throw Error("resolver: " + s.message);
+    for (std::size_t i = 0; i < bodies_.size(); ++i) check_friction(*resolver, bodies_[i], i);
   }
   resolver_ = std::move(resolver);
 }

@@ -26,7 +26,15 @@ class CollisionResolver {
                                : ModuleStatus::failure("this resolver does not support constraints");
   }
 
-  /// Applies impulses to `bodies` for `contacts` (writing each contact's total `impulse`) and
+  /// Checked when a world is built and when a body is added, if any body has `friction` > 0: fails
+  /// (saying why) if this resolver does not model Coulomb friction, so a scene's friction is never
+  /// silently ignored. The default refuses.
+  virtual ModuleStatus accept_friction() noexcept {
+    return ModuleStatus::failure("this resolver does not model friction");
+  }
+
+  /// Applies impulses to `bodies` for `contacts` (writing each contact's total `impulse`,
+  /// `tangent_impulse` and `mode`) and
   /// `constraints`, following the Contact sign convention.
   virtual void resolve(std::span<RigidBody> bodies, std::span<Contact> contacts,
                        std::span<const Constraint> constraints, const StepContext& ctx,

@@ -43,6 +43,12 @@ struct ResolverCounters {
   double residual = 0.0;               ///< largest approach velocity left after resolving (m/s, ≥ 0)
   double complementarity_error = 0.0;  ///< largest |p · v_n⁺| over the contacts (N·m/s)
   std::uint64_t energy_gain_events = 0;  ///< islands whose kinetic energy rose in an impact (mixed restitution)
+  std::uint64_t sticking = 0;          ///< contacts that stuck (an impulse, no slip after it)
+  std::uint64_t sliding = 0;           ///< contacts that slid (an impulse, slip after it)
+  /// Largest natural-map residual ‖r − P_K(r − (u + μ‖u_t‖ n))‖ of a frictional contact problem solved
+  /// this step (fclib's measure without its scaling; 0 when no contact has friction).
+  double natural_map_residual = 0.0;
+  double friction_work = 0.0;          ///< work of the tangential impulses (J, ≤ 0: friction dissipates)
 };
 
 }  // namespace impetus

@@ -22,8 +22,9 @@ namespace impetus {
 class ModuleOptions;
 
 /// Version of this ABI. Bump on any change to PluginDescriptor or to the module interfaces.
-/// 2: the descriptor carries the layout words.
-inline constexpr std::uint32_t kPluginAbiVersion = 2;
+/// 2: the descriptor carries the layout words. 3: friction (CollisionResolver::accept_friction, the
+/// contact's tangential impulse and mode, the resolver's friction counters).
+inline constexpr std::uint32_t kPluginAbiVersion = 3;
 
 /// Name of the entry symbol every plugin exports.
 inline constexpr const char* kPluginEntrySymbol = "impetus_plugin_descriptor";

@@ -81,7 +81,8 @@ inline LayoutWords plugin_layout_words() {
                                                       &MeshShape::mesh, &MeshShape::hull);
   at(LayoutType::triangle_mesh) = layout_word<TriangleMesh>(&TriangleMesh::vertices, &TriangleMesh::triangles);
   at(LayoutType::contact) = layout_word<Contact>(&Contact::a, &Contact::b, &Contact::point, &Contact::normal,
-                                                 &Contact::depth, &Contact::feature, &Contact::impulse);
+                                                 &Contact::depth, &Contact::feature, &Contact::impulse,
+                                                 &Contact::tangent_impulse, &Contact::mode);
   using PP = PointPointConstraint;
   at(LayoutType::point_point_constraint) =
       layout_word<PP>(&PP::a, &PP::b, &PP::anchor_a, &PP::anchor_b, &PP::level, &PP::collide);
@@ -100,7 +101,8 @@ inline LayoutWords plugin_layout_words() {
   at(LayoutType::resolver_counters) =
       layout_word<RC>(&RC::islands, &RC::contacts, &RC::rounds, &RC::pulling_impulses, &RC::non_converged,
                       &RC::singular_systems, &RC::nan_caught, &RC::residual, &RC::complementarity_error,
-                      &RC::energy_gain_events);
+                      &RC::energy_gain_events, &RC::sticking, &RC::sliding, &RC::natural_map_residual,
+                      &RC::friction_work);
   at(LayoutType::module_status) = layout_word<ModuleStatus>(&ModuleStatus::ok, &ModuleStatus::message);
   at(LayoutType::module_options) = layout_word<ModuleOptions>();  // private fields: size and alignment
   at(LayoutType::option_value) = layout_word<OptionValue>(&OptionValue::text, &OptionValue::items,
