@@ -21,7 +21,7 @@ void Island::measure_complementarity(const Vector& v, const Vector& target_now) 
   double worst = 0.0;  // a local: the member would be kept in memory through the loop
   for (std::size_t i = 0; i < rows.size(); ++i) {
     const auto ei = static_cast<Eigen::Index>(i);
-    if (!equality[i]) worst = std::max(worst, std::abs(impulse_inelastic(ei) * (v(ei) - target_now(ei))));
+    if (normal_row(i)) worst = std::max(worst, std::abs(impulse_inelastic(ei) * (v(ei) - target_now(ei))));
   }
   complementarity = worst;
 }
@@ -100,6 +100,8 @@ ledas::Island LedasResolver::make_island(std::vector<std::uint32_t> rows, std::s
   island.incidence = resolution::Incidence(rows_, island.rows, island.bodies.size(), body_slot_);
   island.a = ledas::assemble_matrix(rows_, island.rows, island.incidence);
   island.equality.resize(m);
+  island.role.resize(m);
+  island.mu.assign(m, 0.0);
   island.target.resize(em);
   island.restitution = ledas::Vector::Zero(em);
   island.impulse_inelastic = ledas::Vector::Zero(em);
@@ -108,8 +110,12 @@ ledas::Island LedasResolver::make_island(std::vector<std::uint32_t> rows, std::s
   for (std::size_t i = 0; i < m; ++i) {
     const ledas::RowInfo& ri = info_[island.rows[i]];
     island.equality[i] = ri.equality;
+    island.role[i] = ri.equality ? ledas::RowRole::equality : ri.tangent ? ledas::RowRole::tangent : ledas::RowRole::normal;
+    if (island.role[i] == ledas::RowRole::normal) island.mu[i] = ri.friction;
+    island.frictional = island.frictional || ri.tangent != 0;
     // Speculative gap: the contact may approach until the gap closes at the end of the step.
-    island.target(static_cast<Eigen::Index>(i)) = ri.equality ? ri.target : std::min(0.0, ri.depth) / dt;
+    island.target(static_cast<Eigen::Index>(i)) =
+        ri.equality ? ri.target : ri.tangent ? 0.0 : std::min(0.0, ri.depth) / dt;
   }
   assign_restitution(island, bodies);
   return island;

@@ -8,6 +8,7 @@
 #include "impetus/resolution/common/impulse_rows.hpp"
 #include "impetus/resolution/common/incidence.hpp"
 #include "impetus/resolution/ledas/constraint_rows.hpp"
+#include "impetus/resolution/ledas/frictional_solver.hpp"
 #include "impetus/resolution/ledas/island_solver.hpp"
 
 #include <cstdint>
@@ -28,7 +29,12 @@ struct Island {
   std::vector<BodyIndex> bodies;      ///< movable bodies, increasing (their slots in `incidence`)
   resolution::Incidence incidence;    ///< rows ↔ movable bodies
   std::vector<char> equality;         ///< joint rows
-  Vector target;                      ///< v_n⁺ bound (m/s): min(0, depth)/dt for contacts, RowInfo::target for joints
+  /// Per row: a joint row, a contact's normal row or one of its tangent rows (friction); μ per normal
+  /// row. Filled for every island; tangent rows exist only for contacts with μ > 0.
+  std::vector<RowRole> role;
+  std::vector<double> mu;
+  bool frictional = false;            ///< some contact of the island has μ > 0 (and so tangent rows)
+  Vector target;                      ///< v_n⁺ bound (m/s): min(0, depth)/dt for contacts, RowInfo::target for joints, 0 for tangent rows
   Vector restitution;                 ///< effective e per row (0 for joint rows)
   Vector impulse_inelastic;           ///< Σ p over rounds (N·s)
   Vector impulse_total;               ///< Σ (1 + e) p over rounds (N·s)
@@ -43,9 +49,11 @@ struct Island {
   Vector velocity;
   bool velocity_current = false;
 
-  /// Sets `complementarity` = max over contact rows of |Σ p · (v_n − target)| at velocities v (after an
-  /// inelastic phase).
+  /// Sets `complementarity` = max over contact normal rows of |Σ p · (v_n − target)| at velocities v (after
+  /// an inelastic phase).
   void measure_complementarity(const Vector& v, const Vector& target_now);
+  /// Whether row i is a contact's normal row (not a joint row, not a tangent row).
+  bool normal_row(std::size_t i) const { return role[i] == RowRole::normal; }
   /// Whether any row bounces (e > 0).
   bool bouncing() const { return restitution.size() > 0 && restitution.maxCoeff() > 0.0; }
 };

@@ -67,6 +67,14 @@ ModuleStatus LedasResolver::accept_constraints(std::span<const Constraint> const
   return ModuleStatus::success();
 }
 
+ModuleStatus LedasResolver::accept_friction() noexcept {
+  if (settings_.mode == LedasMode::paper)
+    return ModuleStatus::failure(
+        "ledas in paper mode does not model friction (the paper gives no friction formulas for its rounds; "
+        "use mode: complementary)");
+  return ModuleStatus::success();
+}
+
 void LedasResolver::resolve(std::span<RigidBody> bodies, std::span<Contact> contacts,
                             std::span<const Constraint> constraints, const StepContext& ctx,
                             ResolverCounters& counters) noexcept {
@@ -81,9 +89,12 @@ void LedasResolver::resolve(std::span<RigidBody> bodies, std::span<Contact> cont
   // A velocity problem without a solution (conflicting joint targets) fails the step's promise; a
   // position correction without one (a body squeezed between fixed bodies) is corrected as far as it
   // can be, and shows only in last_stats().position.infeasible.
-  counters.non_converged += stats_.velocity.non_converged + stats_.velocity.infeasible + stats_.position.non_converged;
+  counters.rounds += stats_.friction.newton_steps + stats_.friction.fallback_sweeps;
+  counters.non_converged += stats_.velocity.non_converged + stats_.velocity.infeasible + stats_.position.non_converged +
+                            stats_.friction.non_converged;
+  counters.natural_map_residual = std::max(counters.natural_map_residual, stats_.friction.residual);
   counters.singular_systems += stats_.velocity.singular + stats_.position.singular;
-  counters.nan_caught += stats_.velocity.nan_caught + stats_.position.nan_caught;
+  counters.nan_caught += stats_.velocity.nan_caught + stats_.position.nan_caught + stats_.friction.nan_caught;
 }
 
 void LedasResolver::resolve_all(std::span<RigidBody> bodies, std::span<Contact> contacts,
@@ -101,7 +112,8 @@ void LedasResolver::resolve_all(std::span<RigidBody> bodies, std::span<Contact> 
   for (std::vector<std::uint32_t>& rows : islands) solve_island(std::move(rows), bodies, contacts, ctx.dt, counters);
 }
 
-// The rows of this step: one per valid contact (eq. 5's direction, eq. 7's arms), then the joints'.
+// The rows of this step: one per valid contact (eq. 5's direction, eq. 7's arms) and, in complementary
+// mode, two tangent rows after it when its μ > 0; then the joints'.
 void LedasResolver::build_rows(std::span<const RigidBody> bodies, std::span<Contact> contacts,
                                std::span<const Constraint> constraints, double dt, ResolverCounters& counters) {
   rows_.clear();
@@ -110,6 +122,8 @@ void LedasResolver::build_rows(std::span<const RigidBody> bodies, std::span<Cont
   for (std::size_t k = 0; k < contacts.size(); ++k) {
     Contact& c = contacts[k];
     c.impulse = 0.0;
+    c.tangent_impulse = Vec3::Zero();
+    c.mode = ContactMode::separate;
     if (!valid_contact(c, bodies.size())) {
       ++counters.nan_caught;
       continue;
@@ -118,7 +132,17 @@ void LedasResolver::build_rows(std::span<const RigidBody> bodies, std::span<Cont
     ledas::RowInfo ri;
     ri.depth = c.depth;
     ri.contact = static_cast<std::int64_t>(k);
+    ri.friction = settings_.mode == LedasMode::complementary ? combined_friction(bodies[c.a], bodies[c.b]) : 0.0;
     info_.push_back(ri);
+    if (ri.friction > 0.0) {
+      Vec3 t[2];
+      tangent_basis(c.normal, t[0], t[1]);
+      for (std::uint8_t j = 0; j < 2; ++j) {
+        rows_.push_back(resolution::make_row(bodies, inertia_, c.a, c.b, c.point, t[j]));
+        ri.tangent = static_cast<std::uint8_t>(j + 1);
+        info_.push_back(ri);
+      }
+    }
   }
   for (const Constraint& c : constraints) ledas::append_constraint_rows(bodies, inertia_, c, dt, rows_, info_);
 }
@@ -129,6 +153,7 @@ void LedasResolver::solve_island(std::vector<std::uint32_t> rows, std::span<Rigi
   ledas::Island island = make_island(std::move(rows), bodies, dt);
   const double energy_before = ledas::kinetic_energy(bodies, island.bodies);
   if (settings_.mode == LedasMode::paper) velocity_paper(island, bodies, counters);
+  else if (island.frictional) velocity_frictional(island, bodies, counters);
   else velocity_complementary(island, bodies, counters);
   const double energy_after = ledas::kinetic_energy(bodies, island.bodies);
   stats_.kinetic_energy_change += energy_after - energy_before;
@@ -143,23 +168,40 @@ void LedasResolver::solve_island(std::vector<std::uint32_t> rows, std::span<Rigi
   for (BodyIndex body : island.bodies) body_slot_[body] = -1;
 }
 
-// After the velocity phase: each contact's total impulse, and the counters' residual (the largest
-// approach left below a contact's target), contacts and complementarity. (The residual is accumulated in
-// a local: the counters may alias the contacts written in the loop, which would keep it in memory.)
+// After the velocity phase: each contact's total impulse (normal and tangential) and mode, and the
+// counters' residual (the largest approach left below a contact's target), contacts, sticking and
+// sliding, and complementarity. (The residual is accumulated in a local: the counters may alias the
+// contacts written in the loop, which would keep it in memory.)
 void LedasResolver::report_island(ledas::Island& island, std::span<const RigidBody> bodies, std::span<Contact> contacts,
                                   ResolverCounters& counters) {
   const ledas::Vector& v = current_velocities(island, bodies);
   double residual = counters.residual;
-  std::uint64_t entered = 0;
+  std::uint64_t entered = 0, sticking = 0, sliding = 0;
   for (std::size_t i = 0; i < island.rows.size(); ++i) {
     const auto ei = static_cast<Eigen::Index>(i);
-    if (island.equality[i]) continue;
+    if (!island.normal_row(i)) continue;
     residual = std::max(residual, island.target(ei) - v(ei));
     if (island.entered[i]) ++entered;
-    contacts[static_cast<std::size_t>(info_[island.rows[i]].contact)].impulse = island.impulse_total(ei);
+    Contact& c = contacts[static_cast<std::size_t>(info_[island.rows[i]].contact)];
+    c.impulse = island.impulse_total(ei);
+    Vec3 slip;
+    if (island.mu[i] > 0.0) {  // tangent rows i + 1, i + 2 along t1, t2
+      const resolution::ImpulseRow &t1 = rows_[island.rows[i + 1]], &t2 = rows_[island.rows[i + 2]];
+      c.tangent_impulse = island.impulse_total(ei + 1) * t1.normal + island.impulse_total(ei + 2) * t2.normal;
+      slip = v(ei + 1) * t1.normal + v(ei + 2) * t2.normal;
+    } else {
+      const Vec3 u = relative_velocity(c, bodies[c.a], bodies[c.b]);
+      slip = u - u.dot(c.normal) * c.normal;
+    }
+    if (c.impulse != 0.0) {
+      c.mode = slip.norm() <= settings_.tolerance ? ContactMode::stick : ContactMode::slide;
+      ++(c.mode == ContactMode::stick ? sticking : sliding);
+    }
   }
   counters.residual = residual;
   counters.contacts += entered;
+  counters.sticking += sticking;
+  counters.sliding += sliding;
   counters.complementarity_error = std::max(counters.complementarity_error, island.complementarity);
 }
 

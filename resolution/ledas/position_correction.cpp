@@ -4,6 +4,8 @@
 #include "island.hpp"
 #include "impetus/resolution/ledas/ledas.hpp"
 
+#include <vector>
+
 namespace impetus {
 
 namespace {
@@ -12,30 +14,42 @@ constexpr double kPositionTolerance = 1e-12;
 }  // namespace
 
 // The same complementarity problem as the complementary mode's impact, with the correction targets as
-// right-hand side; joint rows hold (target 0) so the correction does not drag them.
+// right-hand side; joint rows hold (target 0) so the correction does not drag them. Only along normals:
+// an island with friction leaves its tangent rows out (A restricted to the other rows), so the
+// correction never pushes a body along a slope.
 void LedasResolver::correct_positions(ledas::Island& island, std::span<RigidBody> bodies) {
-  const std::size_t m = island.rows.size();
+  std::vector<ledas::RowIndex> kept;  // local rows of the correction problem (all but tangent rows)
+  ledas::SparseMatrix restricted;
+  if (island.frictional) {
+    for (std::size_t i = 0; i < island.rows.size(); ++i)
+      if (island.role[i] != ledas::RowRole::tangent) kept.push_back(static_cast<ledas::RowIndex>(i));
+    restricted = ledas::principal_submatrix(island.a, kept);
+  }
+  const auto local = [&](std::size_t j) { return island.frictional ? kept[j] : j; };
+  const std::size_t m = island.frictional ? kept.size() : island.rows.size();
   ledas::ComplementarityProblem problem;
-  problem.matrix = &island.a;
-  problem.equality = island.equality;
+  problem.matrix = island.frictional ? &restricted : &island.a;
+  problem.equality.resize(m);
   problem.start.resize(m);
   problem.rhs = ledas::Vector::Zero(static_cast<Eigen::Index>(m));
   problem.tolerance = kPositionTolerance;
   bool needed = false;
-  for (std::size_t i = 0; i < m; ++i) {
+  for (std::size_t j = 0; j < m; ++j) {
+    const std::size_t i = local(j);
+    problem.equality[j] = island.equality[i];
     if (island.equality[i]) continue;
     const double t = resolution::correction_target(info_[island.rows[i]].depth, settings_.resting);
-    problem.rhs(static_cast<Eigen::Index>(i)) = t;
+    problem.rhs(static_cast<Eigen::Index>(j)) = t;
     // q = 0 already meets a target within the problem's tolerance (w = −t ≥ −tolerance): a contact
     // overlapping by the slop plus rounding (a generated pyramid at rest) asks for no solve.
-    problem.start[i] = t > kPositionTolerance;
+    problem.start[j] = t > kPositionTolerance;
     needed = needed || t > kPositionTolerance;
   }
   if (!needed) return;
   const ledas::Vector q = solver_.solve_complementarity(problem, stats_.position);
-  for (std::size_t i = 0; i < m; ++i)
-    if (const double qi = q(static_cast<Eigen::Index>(i)); qi != 0.0)
-      resolution::apply_row_displacement(rows_[island.rows[i]], qi, bodies);
+  for (std::size_t j = 0; j < m; ++j)
+    if (const double qj = q(static_cast<Eigen::Index>(j)); qj != 0.0)
+      resolution::apply_row_displacement(rows_[island.rows[local(j)]], qj, bodies);
 }
 
 }  // namespace impetus

@@ -16,11 +16,11 @@ void LedasResolver::assign_restitution(ledas::Island& island, std::span<const Ri
   double impact_speed = 0.0;
   for (std::size_t i = 0; i < m; ++i) {
     const auto ei = static_cast<Eigen::Index>(i);
-    if (!island.equality[i] && v(ei) <= island.target(ei) + settings_.tolerance)
+    if (island.normal_row(i) && v(ei) <= island.target(ei) + settings_.tolerance)
       impact_speed = std::max(impact_speed, -v(ei));
   }
   for (std::size_t i = 0; i < m; ++i)
-    if (!island.equality[i])
+    if (island.normal_row(i))
       island.restitution(static_cast<Eigen::Index>(i)) =
           resolution::effective_restitution(rows_[island.rows[i]], impact_speed, settings_.resting);
 }

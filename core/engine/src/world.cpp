@@ -66,7 +66,7 @@ void check_friction(CollisionResolver& resolver, const RigidBody& body, std::siz
   if (ModuleStatus s = resolver.accept_friction(); !s)
     throw Error("resolver: " + s.message + ", but " + body_label(body, index) + " has friction " +
                 std::to_string(body.material.friction) +
-                "; choose a resolver that models friction (ledas, mirtich) or set its friction to 0");
+                "; set its friction to 0 or choose a resolver (or mode) that models friction, such as ledas or mirtich");
 }
 
 }  // namespace

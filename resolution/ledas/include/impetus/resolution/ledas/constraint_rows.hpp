@@ -36,6 +36,10 @@ struct RowInfo {
   bool equality = false;        ///< a joint row: impulse of either sign, never released, e = 0
   bool position_level = false;  ///< a joint row of ConstraintLevel::position (target recomputed by the resolver)
   std::int64_t contact = -1;    ///< index of the row's contact, or −1 for a joint row
+  /// A contact's rows: 0 for its normal row, 1 or 2 for its tangent rows (friction), which follow the
+  /// normal row directly (directions t1, t2 of tangent_basis(normal)).
+  std::uint8_t tangent = 0;
+  double friction = 0.0;        ///< a contact's μ (combined_friction; on all three of its rows)
 };
 
 /// A position-level joint row's separation s⁺ (m, along the row) after a step of `dt` at the bodies'

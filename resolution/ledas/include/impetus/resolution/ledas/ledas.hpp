@@ -15,6 +15,7 @@
 #include "impetus/resolution/common/impulse_rows.hpp"
 #include "impetus/resolution/common/resting.hpp"
 #include "impetus/resolution/ledas/constraint_rows.hpp"
+#include "impetus/resolution/ledas/frictional_solver.hpp"
 #include "impetus/resolution/ledas/island_solver.hpp"
 
 #include <cstdint>
@@ -85,6 +86,10 @@ struct LedasStats {
   ledas::SolverStats velocity;       ///< the solver's counts in the velocity phase
   ledas::SolverStats position;       ///< ... and in the position correction
   double kinetic_energy_change = 0.0;  ///< Σ over islands of the velocity phase's ΔE_kin (J)
+  ledas::FrictionalStats friction;   ///< the frictional solver's counts (islands with friction)
+  /// Frictional islands whose restitution phase was scaled back so as not to raise the kinetic energy
+  /// above its pre-impact value (resolution/ledas/README.md, "Restitution with friction").
+  std::uint64_t restitution_capped = 0;
 };
 
 /// The LEDAS resolver: contacts and assembly constraints (point-point, coaxial) in one system per island.
@@ -115,6 +120,9 @@ class LedasResolver final : public CollisionResolver {
 
   /// Accepts point-point and coaxial constraints at either level; refuses one with a bad axis or length.
   ModuleStatus accept_constraints(std::span<const Constraint> constraints) noexcept override;
+  /// Complementary mode models Coulomb friction; paper mode refuses it (the paper gives no friction
+  /// formulas for its rounds).
+  ModuleStatus accept_friction() noexcept override;
 
   /// Resolves `contacts` and `constraints` (see the class comment), writing Contact::impulse.
   void resolve(std::span<RigidBody> bodies, std::span<Contact> contacts, std::span<const Constraint> constraints,
@@ -139,6 +147,10 @@ class LedasResolver final : public CollisionResolver {
   const ledas::Vector& current_velocities(ledas::Island& island, std::span<const RigidBody> bodies) const;
   void velocity_paper(ledas::Island& island, std::span<RigidBody> bodies, ResolverCounters& counters);
   void velocity_complementary(ledas::Island& island, std::span<RigidBody> bodies, ResolverCounters& counters);
+  void velocity_frictional(ledas::Island& island, std::span<RigidBody> bodies, ResolverCounters& counters);
+  ledas::Vector solve_frictional(ledas::Island& island, const ledas::Vector& q);
+  void apply_island_impulse(ledas::Island& island, const ledas::Vector& p, std::span<RigidBody> bodies,
+                            ResolverCounters& counters);
   void narrow_start_set(const ledas::Island& island, const ledas::Vector& v, std::vector<char>& start);
   void finish_round(ledas::Island& island, const ledas::Vector& p, const ledas::Vector& target,
                     std::span<RigidBody> bodies);
@@ -148,6 +160,7 @@ class LedasResolver final : public CollisionResolver {
 
   LedasSettings settings_;
   ledas::IslandSolver solver_;
+  ledas::FrictionalSolver friction_solver_;
   LedasStats stats_;
   std::vector<resolution::ImpulseRow> rows_;  // this step's rows: contacts first, then joint rows
   std::vector<ledas::RowInfo> info_;

@@ -1,0 +1,115 @@
+// The complementary mode on an island with friction (resolution/ledas/README.md, "Friction"): the
+// inelastic frictional impact solved exactly and simultaneously (frictional_solver.hpp), then a
+// restitution phase that is itself a frictional impact, scaled back if it would raise the kinetic energy.
+#include "island.hpp"
+#include "impetus/resolution/ledas/ledas.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+namespace impetus {
+
+namespace {
+// Relative accuracy of the frictional solve: its natural-map residual ≤ this × ‖q‖ ...
+constexpr double kFrictionalRelativeTolerance = 1e-10;
+// ... or ≤ this, absolute, when q is tiny.
+constexpr double kFrictionalAbsoluteTolerance = 1e-12;
+// Position-level joint re-targeting rounds of the inelastic phase at most (each halves the gap or stops).
+constexpr std::uint64_t kJointRounds = 16;
+}  // namespace
+
+using ledas::Vector;
+
+// Solves the island's frictional problem u = A r + q (A = W over the island's rows, q = v − target).
+Vector LedasResolver::solve_frictional(ledas::Island& island, const Vector& q) {
+  ledas::FrictionalProblem problem;
+  problem.w = &island.a;
+  problem.q = q;
+  problem.role = island.role;
+  problem.mu = island.mu;
+  problem.tolerance = std::max(kFrictionalRelativeTolerance * q.norm(), kFrictionalAbsoluteTolerance);
+  return friction_solver_.solve(problem, stats_.friction);
+}
+
+// Applies the impulses p on the island's rows (eq. 3 per row, tangent rows along t1, t2) and adds the
+// tangent rows' work Σ p_t (v_t⁻ + v_t⁺)/2 to friction_work (exact for one simultaneous impulse: ΔE_kin =
+// pᵀ(v⁻ + v⁺)/2 row by row).
+void LedasResolver::apply_island_impulse(ledas::Island& island, const Vector& p, std::span<RigidBody> bodies,
+                                         ResolverCounters& counters) {
+  const Vector before = current_velocities(island, bodies);
+  for (std::size_t i = 0; i < island.rows.size(); ++i)
+    if (const double pi = p(static_cast<Eigen::Index>(i)); pi != 0.0)
+      resolution::apply_row_impulse(rows_[island.rows[i]], pi, bodies);
+  island.velocity_current = false;
+  const Vector& after = current_velocities(island, bodies);
+  double work = 0.0;
+  for (std::size_t i = 0; i < island.rows.size(); ++i)
+    if (island.role[i] == ledas::RowRole::tangent) {
+      const auto ei = static_cast<Eigen::Index>(i);
+      work += 0.5 * p(ei) * (before(ei) + after(ei));
+    }
+  counters.friction_work += work;
+  island.impulse_total += p;
+}
+
+// Phase 1: the inelastic frictional impact (every contact's mode found together), re-solved while
+// position-level joints re-target. Phase 2, with restitution: a frictional impact whose normal targets
+// are e |v_n⁻| (Newton's rule, simultaneously), which with friction can raise the kinetic energy (Kane's
+// rod); its impulse is then scaled by the largest α ≤ 1 that keeps the energy at or below its pre-impact
+// value (ΔE is quadratic in α), so no impact creates energy for any e ≤ 1.
+void LedasResolver::velocity_frictional(ledas::Island& island, std::span<RigidBody> bodies, ResolverCounters& counters) {
+  const std::size_t m = island.rows.size();
+  const Vector v0 = current_velocities(island, bodies);
+  const double energy0 = ledas::kinetic_energy(bodies, island.bodies);
+  bool needed = false;
+  for (std::size_t i = 0; i < m; ++i) {
+    const auto ei = static_cast<Eigen::Index>(i);
+    if (island.role[i] == ledas::RowRole::equality) needed = needed || std::abs(v0(ei) - island.target(ei)) > settings_.tolerance;
+    if (!island.normal_row(i)) continue;
+    const bool touching = v0(ei) <= island.target(ei) + settings_.tolerance;
+    if (touching) island.entered[i] = 1;
+    needed = needed || v0(ei) < island.target(ei) - settings_.tolerance;
+  }
+  for (std::uint64_t round = 0; round < kJointRounds; ++round) {
+    const Vector& v = current_velocities(island, bodies);
+    const bool refine = ledas::retarget_joints(island, rows_, info_, v, bodies);
+    if (round > 0 && !refine) break;
+    if (round == 0 && !needed && !refine) return;
+    const Vector r = solve_frictional(island, v - island.target);
+    for (std::size_t i = 0; i < m; ++i)
+      if (r(static_cast<Eigen::Index>(i)) != 0.0 && island.normal_row(i)) island.entered[i] = 1;
+    island.impulse_inelastic += r;
+    apply_island_impulse(island, r, bodies, counters);
+    ++island.rounds;
+  }
+  const Vector v1 = current_velocities(island, bodies);
+  island.measure_complementarity(v1, island.target);
+  if (!island.bouncing()) return;
+
+  // Phase 2: normal targets e |v_n⁻| where the contact bounces, the step's targets elsewhere.
+  Vector target = island.target;
+  bool bounce = false;
+  for (std::size_t i = 0; i < m; ++i) {
+    const auto ei = static_cast<Eigen::Index>(i);
+    if (!island.normal_row(i) || island.restitution(ei) == 0.0 || island.impulse_inelastic(ei) <= 0.0) continue;
+    target(ei) = std::max(target(ei), island.restitution(ei) * std::max(0.0, -v0(ei)));
+    bounce = bounce || v1(ei) < target(ei) - settings_.tolerance;
+  }
+  if (!bounce) return;
+  Vector r = solve_frictional(island, v1 - target);
+  // ΔE(α) = α rᵀv₁ + ½ α² rᵀ A r; the budget is what phase 1 dissipated.
+  const double linear = r.dot(v1), quadratic = 0.5 * r.dot(island.a * r);
+  const double budget = std::max(0.0, energy0 - ledas::kinetic_energy(bodies, island.bodies));
+  if (linear + quadratic > budget + 0.5 * ledas::kRoundoff * energy0) {  // beyond rounding
+    const double alpha = quadratic > 0.0
+                             ? (-linear + std::sqrt(std::max(0.0, linear * linear + 4.0 * quadratic * budget))) /
+                                   (2.0 * quadratic)
+                             : (linear < 0.0 ? 1.0 : 0.0);
+    r *= std::clamp(alpha, 0.0, 1.0);
+    ++stats_.restitution_capped;
+  }
+  apply_island_impulse(island, r, bodies, counters);
+  ++island.rounds;
+}
+
+}  // namespace impetus

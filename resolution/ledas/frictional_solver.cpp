@@ -1,0 +1,329 @@
+// The frictional contact problem of one island (frictional_solver.hpp): semismooth Newton on the
+// Alart–Curnier function with a line search, a projected Gauss–Seidel fallback, fclib's natural-map
+// residual as the error.
+#include "impetus/resolution/ledas/frictional_solver.hpp"
+
+#include <Eigen/LU>
+#include <Eigen/SparseLU>
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+
+namespace impetus::ledas {
+
+namespace {
+
+// Armijo's constant and the shortest step tried by the line search.
+constexpr double kArmijo = 1e-4;
+constexpr double kShortestStep = 1e-10;
+// The fallback measures its residual every this many sweeps.
+constexpr std::uint64_t kSweepsPerCheck = 10;
+
+// One contact (or joint row) of the problem: its rows first .. first + size − 1.
+struct Block {
+  Eigen::Index first = 0;
+  int size = 1;  // 1 (joint row, frictionless contact) or 3 (normal, t1, t2)
+  RowRole role = RowRole::normal;
+  double mu = 0.0;
+  double rho_n = 1.0, rho_t = 1.0;  // the Alart–Curnier weights: 1/W_nn and 2/(W_t1t1 + W_t2t2)
+};
+
+// How the Alart–Curnier function is linearized at the current iterate, per block.
+enum class Piece : std::uint8_t {
+  open,    // z_n ≤ 0 (separating): F = r
+  active,  // F = ρ u on every row (a joint row, a pressed frictionless contact, a sticking contact)
+  slide    // normal row ρ_n u_n, tangent rows r_t − μ z_n ẑ_t
+};
+
+struct Linearization {
+  Piece piece = Piece::open;
+  double dir1 = 0.0, dir2 = 0.0;  // slide: ẑ_t
+  double ratio = 0.0;             // slide: c = μ z_n / ‖z_t‖ (< 1)
+};
+
+std::vector<Block> make_blocks(const FrictionalProblem& problem, const Vector& diagonal) {
+  const auto m = problem.q.size();
+  if (problem.role.size() != static_cast<std::size_t>(m) || problem.mu.size() != static_cast<std::size_t>(m))
+    throw std::invalid_argument("frictional problem: role and mu must have one entry per row");
+  std::vector<Block> blocks;
+  for (Eigen::Index i = 0; i < m;) {
+    Block b;
+    b.first = i;
+    b.role = problem.role[static_cast<std::size_t>(i)];
+    if (b.role == RowRole::tangent) throw std::invalid_argument("frictional problem: a tangent row without its normal row");
+    const double mu = problem.mu[static_cast<std::size_t>(i)];
+    if (b.role == RowRole::normal && mu > 0.0) {
+      if (i + 2 >= m || problem.role[static_cast<std::size_t>(i + 1)] != RowRole::tangent ||
+          problem.role[static_cast<std::size_t>(i + 2)] != RowRole::tangent)
+        throw std::invalid_argument("frictional problem: a frictional normal row must be followed by two tangent rows");
+      b.size = 3;
+      b.mu = mu;
+    }
+    b.rho_n = diagonal(i) > 0.0 ? 1.0 / diagonal(i) : 1.0;
+    if (b.size == 3) {
+      const double trace = diagonal(i + 1) + diagonal(i + 2);
+      b.rho_t = trace > 0.0 ? 2.0 / trace : b.rho_n;
+    }
+    blocks.push_back(b);
+    i += b.size;
+  }
+  return blocks;
+}
+
+// F (the Alart–Curnier function) at r with u = W r + q, and how each block is linearized there.
+void evaluate(const std::vector<Block>& blocks, const Vector& r, const Vector& u, Vector& f,
+              std::vector<Linearization>& lin) {
+  lin.resize(blocks.size());
+  for (std::size_t k = 0; k < blocks.size(); ++k) {
+    const Block& b = blocks[k];
+    const Eigen::Index n = b.first;
+    Linearization& l = lin[k];
+    if (b.role == RowRole::equality) {
+      l.piece = Piece::active;
+      f(n) = b.rho_n * u(n);
+      continue;
+    }
+    const double zn = r(n) - b.rho_n * u(n);
+    if (zn <= 0.0) {
+      l.piece = Piece::open;
+      for (int j = 0; j < b.size; ++j) f(n + j) = r(n + j);
+      continue;
+    }
+    f(n) = b.rho_n * u(n);
+    l.piece = Piece::active;
+    if (b.size == 1) continue;
+    const double z1 = r(n + 1) - b.rho_t * u(n + 1), z2 = r(n + 2) - b.rho_t * u(n + 2);
+    const double radius = b.mu * zn, norm = std::hypot(z1, z2);
+    if (norm <= radius) {  // inside the disk: F_t = r_t − z_t = ρ_t u_t (stick)
+      f(n + 1) = b.rho_t * u(n + 1);
+      f(n + 2) = b.rho_t * u(n + 2);
+      continue;
+    }
+    l.piece = Piece::slide;
+    l.dir1 = z1 / norm;
+    l.dir2 = z2 / norm;
+    l.ratio = radius / norm;
+    f(n + 1) = r(n + 1) - radius * l.dir1;
+    f(n + 2) = r(n + 2) - radius * l.dir2;
+  }
+}
+
+// The generalized Jacobian of F, built through `add(row, col, value)` (duplicates add up). W is taken
+// with its diagonal shifted by `shift`.
+template <typename Add>
+void assemble_jacobian(const std::vector<Block>& blocks, const std::vector<Linearization>& lin,
+                       const SparseMatrix& w, double shift, Add&& add) {
+  // add(row, ·) += scale × (W + shift I)(source, ·); W is symmetric, so its row is its column.
+  const auto add_w_row = [&](Eigen::Index row, Eigen::Index source, double scale) {
+    if (scale == 0.0) return;
+    for (SparseMatrix::InnerIterator it(w, source); it; ++it) add(row, it.row(), scale * it.value());
+    add(row, source, scale * shift);
+  };
+  for (std::size_t k = 0; k < blocks.size(); ++k) {
+    const Block& b = blocks[k];
+    const Linearization& l = lin[k];
+    const Eigen::Index n = b.first;
+    if (l.piece == Piece::open) {
+      for (int j = 0; j < b.size; ++j) add(n + j, n + j, 1.0);
+      continue;
+    }
+    add_w_row(n, n, b.rho_n);
+    if (b.size == 1) continue;
+    if (l.piece == Piece::active) {
+      add_w_row(n + 1, n + 1, b.rho_t);
+      add_w_row(n + 2, n + 2, b.rho_t);
+      continue;
+    }
+    // Slide: dF_t = dr_t − μ ẑ dz_n − c (I − ẑẑᵀ) dz_t with dz_n = dr_n − ρ_n du_n, dz_t = dr_t − ρ_t du_t.
+    const double dir[2] = {l.dir1, l.dir2};
+    for (int a = 0; a < 2; ++a) {
+      const Eigen::Index row = n + 1 + a;
+      add(row, n, -b.mu * dir[a]);
+      add_w_row(row, n, b.mu * b.rho_n * dir[a]);
+      for (int c = 0; c < 2; ++c) {
+        const double projector = (a == c ? 1.0 : 0.0) - dir[a] * dir[c];
+        add(row, n + 1 + c, (a == c ? 1.0 : 0.0) - l.ratio * projector);
+        add_w_row(row, n + 1 + c, l.ratio * b.rho_t * projector);
+      }
+    }
+  }
+}
+
+// The Newton direction: J d = −F. Empty if the system could not be solved to finite values.
+Vector newton_direction(const std::vector<Block>& blocks, const std::vector<Linearization>& lin,
+                        const SparseMatrix& w, double shift, const Vector& f, std::size_t dense_limit) {
+  const Eigen::Index m = f.size();
+  Vector d;
+  if (static_cast<std::size_t>(m) <= dense_limit) {
+    Eigen::MatrixXd j = Eigen::MatrixXd::Zero(m, m);
+    assemble_jacobian(blocks, lin, w, shift, [&j](Eigen::Index r, Eigen::Index c, double v) { j(r, c) += v; });
+    d = Eigen::PartialPivLU<Eigen::MatrixXd>(j).solve(-f);
+  } else {
+    std::vector<Eigen::Triplet<double>> entries;
+    entries.reserve(static_cast<std::size_t>(w.nonZeros()) * 2 + static_cast<std::size_t>(m) * 4);
+    assemble_jacobian(blocks, lin, w, shift,
+                      [&entries](Eigen::Index r, Eigen::Index c, double v) { entries.emplace_back(r, c, v); });
+    SparseMatrix j(m, m);
+    j.setFromTriplets(entries.begin(), entries.end());
+    Eigen::SparseLU<SparseMatrix, Eigen::COLAMDOrdering<int>> lu;
+    lu.compute(j);
+    if (lu.info() != Eigen::Success) return {};
+    d = lu.solve(-f);
+    if (lu.info() != Eigen::Success) return {};
+  }
+  return d.allFinite() ? d : Vector();
+}
+
+// One projected Gauss–Seidel sweep over the blocks, each block's u from the current r.
+void gauss_seidel_sweep(const std::vector<Block>& blocks, const SparseMatrix& w, const Vector& q,
+                        const Vector& diagonal, Vector& r) {
+  const auto velocity = [&](Eigen::Index i) {
+    double u = q(i);
+    for (SparseMatrix::InnerIterator it(w, i); it; ++it) u += it.value() * r(it.row());
+    return u;
+  };
+  for (const Block& b : blocks) {
+    const Eigen::Index n = b.first;
+    if (!(diagonal(n) > 0.0)) continue;  // nothing movable behind the row
+    if (b.role == RowRole::equality) {
+      r(n) -= velocity(n) / diagonal(n);
+      continue;
+    }
+    if (b.size == 1) {
+      r(n) = std::max(0.0, r(n) - velocity(n) / diagonal(n));
+      continue;
+    }
+    const double un = velocity(n), u1 = velocity(n + 1), u2 = velocity(n + 2);
+    r(n) = std::max(0.0, r(n) - b.rho_n * un);
+    double t1 = r(n + 1) - b.rho_t * u1, t2 = r(n + 2) - b.rho_t * u2;
+    const double radius = b.mu * r(n), norm = std::hypot(t1, t2);
+    if (norm > radius) {
+      const double scale = norm > 0.0 ? radius / norm : 0.0;
+      t1 *= scale;
+      t2 *= scale;
+    }
+    r(n + 1) = t1;
+    r(n + 2) = t2;
+  }
+}
+
+}  // namespace
+
+void project_on_cone(double mu, double& yn, double& yt1, double& yt2) {
+  const double norm = std::hypot(yt1, yt2);
+  if (norm <= mu * yn) return;          // inside the cone
+  if (mu * norm <= -yn) {               // inside the polar cone: the apex
+    yn = yt1 = yt2 = 0.0;
+    return;
+  }
+  const double s = (yn + mu * norm) / (1.0 + mu * mu);  // onto the cone's surface
+  yn = s;
+  const double scale = mu * s / norm;
+  yt1 *= scale;
+  yt2 *= scale;
+}
+
+double natural_map_residual(const FrictionalProblem& problem, const Vector& r) {
+  const Vector u = *problem.w * r + problem.q;
+  double sum = 0.0;
+  const auto m = r.size();
+  for (Eigen::Index i = 0; i < m;) {
+    const auto k = static_cast<std::size_t>(i);
+    if (problem.role[k] == RowRole::equality) {
+      sum += u(i) * u(i);
+      ++i;
+      continue;
+    }
+    const double mu = problem.mu[k];
+    if (!(mu > 0.0)) {
+      const double e = r(i) - std::max(0.0, r(i) - u(i));
+      sum += e * e;
+      ++i;
+      continue;
+    }
+    // y = r − (u + μ‖u_t‖ e_n) (De Saxcé's modified velocity), then r − P_K(y).
+    double yn = r(i) - u(i) - mu * std::hypot(u(i + 1), u(i + 2));
+    double y1 = r(i + 1) - u(i + 1), y2 = r(i + 2) - u(i + 2);
+    project_on_cone(mu, yn, y1, y2);
+    const double en = r(i) - yn, e1 = r(i + 1) - y1, e2 = r(i + 2) - y2;
+    sum += en * en + e1 * e1 + e2 * e2;
+    i += 3;
+  }
+  return std::sqrt(sum);
+}
+
+Vector FrictionalSolver::solve(const FrictionalProblem& problem, FrictionalStats& stats) {
+  const SparseMatrix& w = *problem.w;
+  const Eigen::Index m = problem.q.size();
+  const Vector diagonal = w.diagonal();
+  const std::vector<Block> blocks = make_blocks(problem, diagonal);
+  const double shift = m > 0 ? settings_.regularization * diagonal.maxCoeff() : 0.0;
+  ++stats.problems;
+
+  Vector r = Vector::Zero(m);
+  Vector best = r;
+  double best_residual = natural_map_residual(problem, r);
+  const auto consider = [&](const Vector& candidate) {
+    const double residual = natural_map_residual(problem, candidate);
+    if (residual < best_residual) {
+      best_residual = residual;
+      best = candidate;
+    }
+  };
+
+  Vector u(m), f(m), trial(m), u_trial(m), f_trial(m);
+  std::vector<Linearization> lin, lin_trial;
+  for (int attempt = 0; attempt < 2 && best_residual > problem.tolerance; ++attempt) {
+    if (attempt == 1) {  // Newton stalled: projected Gauss–Seidel from the best iterate, then Newton again
+      ++stats.fallbacks;
+      r = best;
+      for (std::uint64_t sweep = 1; sweep <= settings_.fallback_sweeps; ++sweep) {
+        gauss_seidel_sweep(blocks, w, problem.q, diagonal, r);
+        ++stats.fallback_sweeps;
+        if (sweep % kSweepsPerCheck == 0) {
+          consider(r);
+          if (best_residual <= problem.tolerance) break;
+        }
+      }
+      if (best_residual <= problem.tolerance) break;
+      r = best;
+    }
+    u = w * r + problem.q;
+    evaluate(blocks, r, u, f, lin);
+    double merit = 0.5 * f.squaredNorm();
+    for (std::uint64_t it = 0; it < settings_.newton_iterations && best_residual > problem.tolerance; ++it) {
+      ++stats.newton_steps;
+      const Vector d = newton_direction(blocks, lin, w, shift, f, settings_.dense_limit);
+      if (d.size() == 0) {
+        ++stats.nan_caught;
+        break;
+      }
+      // Armijo on ½‖F‖²: its derivative along the Newton direction is −‖F‖² = −2 merit.
+      double step = 1.0, trial_merit = merit;
+      bool accepted = false;
+      for (; step >= kShortestStep; step *= 0.5) {
+        trial = r + step * d;
+        u_trial = w * trial + problem.q;
+        evaluate(blocks, trial, u_trial, f_trial, lin_trial);
+        trial_merit = 0.5 * f_trial.squaredNorm();
+        if (trial_merit <= (1.0 - 2.0 * kArmijo * step) * merit) {
+          accepted = true;
+          break;
+        }
+      }
+      if (!accepted) break;
+      r.swap(trial);
+      u.swap(u_trial);
+      f.swap(f_trial);
+      lin.swap(lin_trial);
+      merit = trial_merit;
+      consider(r);
+    }
+  }
+  if (best_residual > problem.tolerance) ++stats.non_converged;
+  stats.residual = std::max(stats.residual, best_residual);
+  return best;
+}
+
+}  // namespace impetus::ledas

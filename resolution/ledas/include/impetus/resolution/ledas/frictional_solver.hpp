@@ -1,0 +1,92 @@
+#pragma once
+/// \file
+/// Exact solution of one island's frictional contact problem in its local form (docs/conventions.md,
+/// "Friction"; the form of the Frictional Contact Library, fclib):
+///
+///   u = W r + q,   W = G M⁻¹ Gᵀ (eq. 7 with three rows per frictional contact: normal, t1, t2),
+///
+/// and per frictional contact with coefficient μ (r = (r_n, r_t), u = (u_n, u_t), u_n measured from the
+/// row's target):  r_n ≥ 0, u_n ≥ 0, r_n u_n = 0;  ‖r_t‖ ≤ μ r_n;  and either u_t = 0 (stick) or
+/// r_t = −μ r_n u_t/‖u_t‖ (slide). A frictionless contact is one row of the same complementarity as
+/// the frictionless solver's; a joint row is an equality u = 0 with r free. Knows nothing of bodies:
+/// W and q come in, r comes out, so it is tested (and later fed fclib's problems) directly.
+///
+/// Method (resolution/ledas/README.md, "Friction"): a semismooth Newton method on the Alart–Curnier
+/// function
+///   F_n = r_n − max(0, z_n),  z_n = r_n − ρ_n u_n,
+///   F_t = r_t − P_D(μ max(0, z_n)) (z_t),  z_t = r_t − ρ_t u_t,  P_D(R) the projection on the disk ‖·‖ ≤ R,
+/// whose zeros are exactly the solutions above (ρ > 0 per contact; the cone is round and ρ_t is one
+/// number per contact, so the iteration does not depend on the tangent basis). Each step solves the
+/// generalized Jacobian's system by LU (dense up to `dense_limit` rows, sparse above, W shifted by
+/// `regularization` × max W_ii so redundant contact sets stay solvable), with an Armijo line search on
+/// ½‖F‖². The error is fclib's natural-map residual ‖r − P_K(r − (u + μ‖u_t‖ e_n))‖ (ρ = 1, no scaling).
+/// If Newton stalls, a projected Gauss–Seidel on the cones, warm-started from the best iterate, takes
+/// over for a while, then Newton again; whatever happens, the iterate with the smallest residual is
+/// returned and a failure to reach the tolerance is counted, never hidden.
+
+#include "impetus/resolution/ledas/island_solver.hpp"
+
+#include <cstdint>
+#include <vector>
+
+namespace impetus::ledas {
+
+/// What a row of a frictional problem is.
+enum class RowRole : std::uint8_t {
+  equality,  ///< a joint row: u = 0, r free
+  normal,    ///< a contact's normal row; with μ > 0 its two tangent rows follow it
+  tangent    ///< one of the two tangent rows after a frictional normal row
+};
+
+/// One island's frictional contact problem.
+struct FrictionalProblem {
+  const SparseMatrix* w = nullptr;  ///< W (m × m), symmetric positive semi-definite, both triangles stored
+  Vector q;                         ///< free velocities (m/s), targets already subtracted: u = W r + q
+  std::vector<RowRole> role;        ///< per row
+  std::vector<double> mu;           ///< per row: a normal row's μ (0: frictionless, no tangent rows follow)
+  double tolerance = 1e-12;         ///< natural-map residual to reach (absolute)
+};
+
+/// How frictional problems are solved (configuration).
+struct FrictionalSettings {
+  std::size_t dense_limit = 96;          ///< Jacobians of at most this many rows are factorized dense
+  std::uint64_t newton_iterations = 60;  ///< Newton steps per attempt (two attempts around the fallback)
+  std::uint64_t fallback_sweeps = 2000;  ///< projected Gauss–Seidel sweeps of the fallback
+  double regularization = 1e-10;         ///< W's diagonal shift in the Jacobian, × max W_ii
+};
+
+/// What the solver did, accumulated over calls (reset by the caller).
+struct FrictionalStats {
+  std::uint64_t problems = 0;          ///< problems solved
+  std::uint64_t newton_steps = 0;      ///< Newton steps (one factorization each)
+  std::uint64_t fallbacks = 0;         ///< problems where the projected Gauss–Seidel fallback ran
+  std::uint64_t fallback_sweeps = 0;   ///< its sweeps
+  std::uint64_t non_converged = 0;     ///< problems left above the tolerance (best iterate returned)
+  std::uint64_t nan_caught = 0;        ///< non-finite steps rejected
+  double residual = 0.0;               ///< largest natural-map residual returned
+};
+
+/// The natural-map residual of `r` (fclib's error without its scaling): the 2-norm over rows of
+/// r − P_K(r − (u + μ‖u_t‖ e_n)) for frictional contacts, r − max(0, r − u) for frictionless ones and u
+/// for joint rows, with u = W r + q.
+double natural_map_residual(const FrictionalProblem& problem, const Vector& r);
+
+/// Projects y = (y_n, y_t1, y_t2) on the cone ‖y_t‖ ≤ μ y_n (in place).
+void project_on_cone(double mu, double& yn, double& yt1, double& yt2);
+
+/// Solves frictional problems (see the file comment). Not thread-safe; one per resolver.
+class FrictionalSolver {
+ public:
+  explicit FrictionalSolver(FrictionalSettings settings = {}) : settings_(settings) {}
+
+  /// Returns r (m): the iterate with the smallest natural-map residual, which is ≤ problem.tolerance
+  /// unless counted in stats.non_converged.
+  Vector solve(const FrictionalProblem& problem, FrictionalStats& stats);
+
+  const FrictionalSettings& settings() const { return settings_; }
+
+ private:
+  FrictionalSettings settings_;
+};
+
+}  // namespace impetus::ledas
