@@ -27,6 +27,7 @@ Vector LedasResolver::solve_frictional(ledas::Island& island, const Vector& q) {
   problem.q = q;
   problem.role = island.role;
   problem.mu = island.mu;
+  problem.dofs = 6 * island.bodies.size();
   problem.tolerance = std::max(kFrictionalRelativeTolerance * q.norm(), kFrictionalAbsoluteTolerance);
   return friction_solver_.solve(problem, stats_.friction);
 }

@@ -12,22 +12,23 @@
 
 namespace impetus::ledas {
 
-namespace {
-
-// Armijo's constant and the shortest step tried by the line search.
-constexpr double kArmijo = 1e-4;
-constexpr double kShortestStep = 1e-10;
-// The fallback measures its residual every this many sweeps.
-constexpr std::uint64_t kSweepsPerCheck = 10;
-
 // One contact (or joint row) of the problem: its rows first .. first + size − 1.
-struct Block {
+struct FrictionalSolver::Block {
   Eigen::Index first = 0;
   int size = 1;  // 1 (joint row, frictionless contact) or 3 (normal, t1, t2)
   RowRole role = RowRole::normal;
   double mu = 0.0;
   double rho_n = 1.0, rho_t = 1.0;  // the Alart–Curnier weights: 1/W_nn and 2/(W_t1t1 + W_t2t2)
 };
+
+namespace {
+
+// Armijo's constant and the shortest step tried by the line search.
+constexpr double kArmijo = 1e-4;
+constexpr double kShortestStep = 1e-10;
+
+using Block = FrictionalSolver::Block;
+
 
 // How the Alart–Curnier function is linearized at the current iterate, per block.
 enum class Piece : std::uint8_t {
@@ -208,6 +209,12 @@ void gauss_seidel_sweep(const std::vector<Block>& blocks, const SparseMatrix& w,
   }
 }
 
+// More rows than degrees of freedom behind them: W is singular for sure (a box on four corners, a
+// stack), and Newton on the problem itself would only stall.
+bool likely_redundant(const FrictionalProblem& problem) {
+  return problem.dofs > 0 && static_cast<std::size_t>(problem.q.size()) > problem.dofs;
+}
+
 }  // namespace
 
 void project_on_cone(double mu, double& yn, double& yt1, double& yt2) {
@@ -253,77 +260,127 @@ double natural_map_residual(const FrictionalProblem& problem, const Vector& r) {
   return std::sqrt(sum);
 }
 
+// Newton's method on `problem` from r (which it overwrites with the best iterate it met, by the
+// natural-map residual of `problem`); at most `iterations` steps. Returns that residual.
+double FrictionalSolver::newton(const FrictionalProblem& problem, const std::vector<Block>& blocks, Vector& r,
+                                std::uint64_t iterations, FrictionalStats& stats) {
+  const SparseMatrix& w = *problem.w;
+  const Eigen::Index m = problem.q.size();
+  const double shift = m > 0 ? settings_.regularization * w.diagonal().maxCoeff() : 0.0;
+  Vector best = r;
+  double best_residual = natural_map_residual(problem, r);
+  Vector u = w * r + problem.q, f(m), trial(m), u_trial(m), f_trial(m);
+  std::vector<Linearization> lin, lin_trial;
+  evaluate(blocks, r, u, f, lin);
+  double merit = 0.5 * f.squaredNorm();
+  for (std::uint64_t it = 0; it < iterations && best_residual > problem.tolerance; ++it) {
+    ++stats.newton_steps;
+    const Vector d = newton_direction(blocks, lin, w, shift, f, settings_.dense_limit);
+    if (d.size() == 0) {
+      ++stats.nan_caught;
+      break;
+    }
+    // Armijo on ½‖F‖²: its derivative along the Newton direction is −‖F‖² = −2 merit.
+    double step = 1.0, trial_merit = merit;
+    bool accepted = false;
+    for (; step >= kShortestStep; step *= 0.5) {
+      trial = r + step * d;
+      u_trial = w * trial + problem.q;
+      evaluate(blocks, trial, u_trial, f_trial, lin_trial);
+      trial_merit = 0.5 * f_trial.squaredNorm();
+      if (trial_merit <= (1.0 - 2.0 * kArmijo * step) * merit) {
+        accepted = true;
+        break;
+      }
+    }
+    if (!accepted) break;
+    r.swap(trial);
+    u.swap(u_trial);
+    f.swap(f_trial);
+    lin.swap(lin_trial);
+    merit = trial_merit;
+    if (const double residual = natural_map_residual(problem, r); residual < best_residual) {
+      best_residual = residual;
+      best = r;
+    }
+  }
+  r = best;
+  return best_residual;
+}
+
+// Proximal points from r: Newton on u = (W + εI) r + q − ε r̄, r̄ moved to each subproblem's solution,
+// ε shrinking by 100 after each converged subproblem; stops at the first subproblem Newton cannot solve,
+// or when the problem itself is solved. A fixed point solves the problem itself; along W's null space
+// (redundant contacts) the impulses stay near where they started instead of running off.
+Vector FrictionalSolver::proximal_newton(const FrictionalProblem& problem, const std::vector<Block>& blocks, Vector r,
+                                         FrictionalStats& stats) {
+  const double scale = problem.w->diagonal().maxCoeff();
+  const double floor = settings_.regularization * scale;
+  double epsilon = settings_.proximal * scale;
+  SparseMatrix shifted;
+  FrictionalProblem sub;
+  sub.role = problem.role;
+  sub.mu = problem.mu;
+  sub.tolerance = 0.5 * problem.tolerance;
+  for (std::uint64_t outer = 0; outer < settings_.proximal_iterations; ++outer) {
+    ++stats.proximal_steps;
+    shifted = *problem.w;
+    shifted.diagonal().array() += epsilon;
+    sub.w = &shifted;
+    sub.q = problem.q - epsilon * r;
+    Vector next = r;
+    const bool converged = newton(sub, blocks, next, settings_.proximal_newton_iterations, stats) <= sub.tolerance;
+    if (!converged) break;
+    r = next;
+    if (natural_map_residual(problem, r) <= problem.tolerance) break;
+    epsilon = std::max(0.01 * epsilon, floor);
+  }
+  return r;
+}
+
 Vector FrictionalSolver::solve(const FrictionalProblem& problem, FrictionalStats& stats) {
   const SparseMatrix& w = *problem.w;
   const Eigen::Index m = problem.q.size();
   const Vector diagonal = w.diagonal();
   const std::vector<Block> blocks = make_blocks(problem, diagonal);
-  const double shift = m > 0 ? settings_.regularization * diagonal.maxCoeff() : 0.0;
   ++stats.problems;
 
-  Vector r = Vector::Zero(m);
-  Vector best = r;
-  double best_residual = natural_map_residual(problem, r);
-  const auto consider = [&](const Vector& candidate) {
-    const double residual = natural_map_residual(problem, candidate);
-    if (residual < best_residual) {
-      best_residual = residual;
-      best = candidate;
-    }
-  };
+  // 1. Newton on the problem itself, from r = 0: enough whenever W is well conditioned on the contacts
+  //    that end up pressed.
+  Vector r = problem.start != nullptr && problem.start->size() == m && problem.start->allFinite() ? *problem.start
+                                                                                                 : Vector::Zero(m);
+  double residual = natural_map_residual(problem, r);
+  if (!likely_redundant(problem) || problem.start != nullptr)
+    residual = newton(problem, blocks, r, settings_.newton_iterations, stats);
 
-  Vector u(m), f(m), trial(m), u_trial(m), f_trial(m);
-  std::vector<Linearization> lin, lin_trial;
-  for (int attempt = 0; attempt < 2 && best_residual > problem.tolerance; ++attempt) {
-    if (attempt == 1) {  // Newton stalled: projected Gauss–Seidel from the best iterate, then Newton again
-      ++stats.fallbacks;
-      r = best;
-      for (std::uint64_t sweep = 1; sweep <= settings_.fallback_sweeps; ++sweep) {
-        gauss_seidel_sweep(blocks, w, problem.q, diagonal, r);
-        ++stats.fallback_sweeps;
-        if (sweep % kSweepsPerCheck == 0) {
-          consider(r);
-          if (best_residual <= problem.tolerance) break;
-        }
-      }
-      if (best_residual <= problem.tolerance) break;
-      r = best;
+  // 2. Redundant contacts or a stalled Newton: proximal Newton steps (fast near a solution, and
+  //    bounded along W's null space), and if they stall, a round of projected Gauss–Seidel sweeps
+  //    (robust, slow; it brings the iterate nearer a solution) before the next try.
+  Vector best = r;
+  double best_residual = residual;
+  for (std::uint64_t round = 0; round < settings_.hybrid_rounds && best_residual > problem.tolerance; ++round) {
+    r = proximal_newton(problem, blocks, best, stats);
+    if (const double now = natural_map_residual(problem, r); now < best_residual) {
+      best_residual = now;
+      best = r;
     }
-    u = w * r + problem.q;
-    evaluate(blocks, r, u, f, lin);
-    double merit = 0.5 * f.squaredNorm();
-    for (std::uint64_t it = 0; it < settings_.newton_iterations && best_residual > problem.tolerance; ++it) {
-      ++stats.newton_steps;
-      const Vector d = newton_direction(blocks, lin, w, shift, f, settings_.dense_limit);
-      if (d.size() == 0) {
-        ++stats.nan_caught;
-        break;
-      }
-      // Armijo on ½‖F‖²: its derivative along the Newton direction is −‖F‖² = −2 merit.
-      double step = 1.0, trial_merit = merit;
-      bool accepted = false;
-      for (; step >= kShortestStep; step *= 0.5) {
-        trial = r + step * d;
-        u_trial = w * trial + problem.q;
-        evaluate(blocks, trial, u_trial, f_trial, lin_trial);
-        trial_merit = 0.5 * f_trial.squaredNorm();
-        if (trial_merit <= (1.0 - 2.0 * kArmijo * step) * merit) {
-          accepted = true;
-          break;
-        }
-      }
-      if (!accepted) break;
-      r.swap(trial);
-      u.swap(u_trial);
-      f.swap(f_trial);
-      lin.swap(lin_trial);
-      merit = trial_merit;
-      consider(r);
+    if (best_residual <= problem.tolerance) break;
+    ++stats.fallbacks;
+    r = best;
+    for (std::uint64_t sweep = 0; sweep < settings_.sweeps_per_round; ++sweep) {
+      gauss_seidel_sweep(blocks, w, problem.q, diagonal, r);
+      ++stats.fallback_sweeps;
+    }
+    if (const double now = natural_map_residual(problem, r); now < best_residual) {
+      best_residual = now;
+      best = r;
     }
   }
-  if (best_residual > problem.tolerance) ++stats.non_converged;
-  stats.residual = std::max(stats.residual, best_residual);
-  return best;
+  r = best;
+  residual = best_residual;
+  if (residual > problem.tolerance) ++stats.non_converged;
+  stats.residual = std::max(stats.residual, residual);
+  return r;
 }
 
 }  // namespace impetus::ledas

@@ -27,6 +27,7 @@ void read_spheres(const SceneReader& r, const Fields& f, Params& p) {
   if (const YAML::Node* n = f.find("mass")) p.mass = r.number(*n, "mass");
   if (const YAML::Node* n = f.find("velocity")) p.velocity = r.vec3(*n, "velocity");
   if (const YAML::Node* n = f.find("restitution")) p.restitution = r.number(*n, "restitution");
+  if (const YAML::Node* n = f.find("friction")) p.friction = r.number(*n, "friction");
   if (const YAML::Node* n = f.find("overlap")) p.overlap = r.number(*n, "overlap");
 }
 
@@ -39,7 +40,7 @@ std::vector<ReadBody> read_generator(const SceneReader& r, const YAML::Node& nod
   // Types are checked here, with locations; ranges by the generator itself, so they live in one place.
   if (kind.key == "pyramid") {
     const Fields f(r, kind.value, "pyramid",
-                   {"rows", "radius", "mass", "velocity", "restitution", "overlap", "ground"});
+                   {"rows", "radius", "mass", "velocity", "restitution", "friction", "overlap", "ground"});
     PyramidParams p;
     p.rows = read_int(r, f.require("rows"), "rows");
     read_spheres(r, f, p);
@@ -50,7 +51,8 @@ std::vector<ReadBody> read_generator(const SceneReader& r, const YAML::Node& nod
       r.fail(f.find(e.field()) ? *f.find(e.field()) : kind.value, e.what());
     }
   } else {
-    const Fields f(r, kind.value, "line", {"count", "radius", "mass", "wall", "velocity", "restitution", "overlap"});
+    const Fields f(r, kind.value, "line", {"count", "radius", "mass", "wall", "velocity", "restitution", "friction",
+                                                 "overlap"});
     LineParams p;
     p.count = read_int(r, f.require("count"), "count");
     read_spheres(r, f, p);

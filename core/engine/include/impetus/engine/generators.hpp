@@ -25,6 +25,7 @@ struct PyramidParams {
   double mass = 1.0;                 ///< of each sphere (kg), > 0
   Vec3 velocity{0.0, 0.0, -1.0};     ///< initial velocity of every sphere (m/s), the paper's "drop"
   double restitution = 0.0;          ///< of every sphere, in [0, 1]
+  double friction = 0.0;             ///< Coulomb μ of every sphere and of the fixed plane, finite, ≥ 0
   double overlap = 1e-4;             ///< penetration relative to the radius, in [0, 1)
   bool ground = true;                ///< add the fixed ground plane
 };
@@ -41,6 +42,7 @@ struct LineParams {
   bool wall = true;                  ///< add the fixed wall plane
   Vec3 velocity{1.0, 0.0, 0.0};      ///< initial velocity of the first sphere (m/s), the paper's "push"
   double restitution = 0.0;          ///< of every sphere, in [0, 1]
+  double friction = 0.0;             ///< Coulomb μ of every sphere and of the fixed plane, finite, ≥ 0
   double overlap = 1e-4;             ///< penetration relative to the radius, in [0, 1)
 };
 

@@ -20,9 +20,11 @@
 /// generalized Jacobian's system by LU (dense up to `dense_limit` rows, sparse above, W shifted by
 /// `regularization` × max W_ii so redundant contact sets stay solvable), with an Armijo line search on
 /// ½‖F‖². The error is fclib's natural-map residual ‖r − P_K(r − (u + μ‖u_t‖ e_n))‖ (ρ = 1, no scaling).
-/// If Newton stalls, a projected Gauss–Seidel on the cones, warm-started from the best iterate, takes
-/// over for a while, then Newton again; whatever happens, the iterate with the smallest residual is
-/// returned and a failure to reach the tolerance is counted, never hidden.
+/// If Newton stalls (redundant contacts make W singular and the impulses non-unique), proximal points
+/// take over: the same Newton on u = (W + εI) r + q − ε r̄, r̄ moved to each solution, ε shrinking. If
+/// that fails too, a projected Gauss–Seidel on the cones from the best iterate, then Newton again;
+/// whatever happens, the iterate with the smallest residual is returned and a failure to reach the
+/// tolerance is counted, never hidden.
 
 #include "impetus/resolution/ledas/island_solver.hpp"
 
@@ -45,20 +47,34 @@ struct FrictionalProblem {
   std::vector<RowRole> role;        ///< per row
   std::vector<double> mu;           ///< per row: a normal row's μ (0: frictionless, no tangent rows follow)
   double tolerance = 1e-12;         ///< natural-map residual to reach (absolute)
+  /// Degrees of freedom behind W (6 per movable body), 0 if unknown. More rows than that: W is singular,
+  /// and the solver starts with its proximal stage.
+  std::size_t dofs = 0;
+  /// Optional first iterate (size m), e.g. the all-stick impulses W r = −q: of several solutions (Coulomb
+  /// friction's are not unique with redundant contacts), Newton finds one near its start.
+  const Vector* start = nullptr;
 };
 
 /// How frictional problems are solved (configuration).
 struct FrictionalSettings {
   std::size_t dense_limit = 96;          ///< Jacobians of at most this many rows are factorized dense
   std::uint64_t newton_iterations = 60;  ///< Newton steps per attempt (two attempts around the fallback)
-  std::uint64_t fallback_sweeps = 2000;  ///< projected Gauss–Seidel sweeps of the fallback
+  std::uint64_t hybrid_rounds = 40;      ///< rounds of proximal Newton then Gauss–Seidel sweeps, at most
+  std::uint64_t sweeps_per_round = 20;   ///< projected Gauss–Seidel sweeps per round
   double regularization = 1e-10;         ///< W's diagonal shift in the Jacobian, × max W_ii
+  double proximal = 1e-6;                ///< the proximal stage's first ε, × max W_ii
+  std::uint64_t proximal_iterations = 8;  ///< proximal points per round at most
+  /// Newton steps per proximal point: near a solution Newton converges in a few; more means it is not
+  /// near one yet, and Gauss–Seidel sweeps take over again.
+  std::uint64_t proximal_newton_iterations = 10;
 };
 
 /// What the solver did, accumulated over calls (reset by the caller).
 struct FrictionalStats {
   std::uint64_t problems = 0;          ///< problems solved
   std::uint64_t newton_steps = 0;      ///< Newton steps (one factorization each)
+  std::uint64_t proximal = 0;          ///< problems that needed the proximal stage (redundant contacts)
+  std::uint64_t proximal_steps = 0;    ///< its proximal points (a Newton solve each)
   std::uint64_t fallbacks = 0;         ///< problems where the projected Gauss–Seidel fallback ran
   std::uint64_t fallback_sweeps = 0;   ///< its sweeps
   std::uint64_t non_converged = 0;     ///< problems left above the tolerance (best iterate returned)
@@ -85,7 +101,14 @@ class FrictionalSolver {
 
   const FrictionalSettings& settings() const { return settings_; }
 
+  struct Block;  // one contact's rows (frictional_solver.cpp)
+
  private:
+  double newton(const FrictionalProblem& problem, const std::vector<Block>& blocks, Vector& r,
+                std::uint64_t iterations, FrictionalStats& stats);
+  Vector proximal_newton(const FrictionalProblem& problem, const std::vector<Block>& blocks, Vector r,
+                         FrictionalStats& stats);
+
   FrictionalSettings settings_;
 };
 
