@@ -308,32 +308,41 @@ double FrictionalSolver::newton(const FrictionalProblem& problem, const std::vec
   return best_residual;
 }
 
-// Proximal points from r: Newton on u = (W + εI) r + q − ε r̄, r̄ moved to each subproblem's solution,
-// ε shrinking by 100 after each converged subproblem; stops at the first subproblem Newton cannot solve,
-// or when the problem itself is solved. A fixed point solves the problem itself; along W's null space
-// (redundant contacts) the impulses stay near where they started instead of running off.
+// Proximal points from r: Newton on u = (W + εI) r + q − ε r̄, r̄ moved to each subproblem's solution. A
+// fixed point solves the problem itself; along W's null space (redundant contacts) the impulses stay near
+// where they started instead of running off. ε adapts: ×0.1 after a subproblem Newton solved (down to
+// the Jacobian's own shift), ×10 after one it could not (up to 0.1 max W_ii: a better conditioned
+// subproblem, a slower but surer outer iteration). Each subproblem is solved only to a fraction of the
+// current error (an inexact proximal point method), the last ones to the tolerance.
 Vector FrictionalSolver::proximal_newton(const FrictionalProblem& problem, const std::vector<Block>& blocks, Vector r,
                                          FrictionalStats& stats) {
   const double scale = problem.w->diagonal().maxCoeff();
-  const double floor = settings_.regularization * scale;
+  const double floor = settings_.regularization * scale, ceiling = 0.1 * scale;
   double epsilon = settings_.proximal * scale;
+  double residual = natural_map_residual(problem, r);
   SparseMatrix shifted;
+  double shifted_by = -1.0;
   FrictionalProblem sub;
   sub.role = problem.role;
   sub.mu = problem.mu;
-  sub.tolerance = 0.5 * problem.tolerance;
-  for (std::uint64_t outer = 0; outer < settings_.proximal_iterations; ++outer) {
+  for (std::uint64_t outer = 0; outer < settings_.proximal_iterations && residual > problem.tolerance; ++outer) {
     ++stats.proximal_steps;
-    shifted = *problem.w;
-    shifted.diagonal().array() += epsilon;
+    if (epsilon != shifted_by) {
+      shifted = *problem.w;
+      shifted.diagonal().array() += epsilon;
+      shifted_by = epsilon;
+    }
     sub.w = &shifted;
     sub.q = problem.q - epsilon * r;
+    sub.tolerance = std::max(0.5 * problem.tolerance, 1e-3 * residual);
     Vector next = r;
-    const bool converged = newton(sub, blocks, next, settings_.proximal_newton_iterations, stats) <= sub.tolerance;
-    if (!converged) break;
-    r = next;
-    if (natural_map_residual(problem, r) <= problem.tolerance) break;
-    epsilon = std::max(0.01 * epsilon, floor);
+    if (newton(sub, blocks, next, settings_.proximal_newton_iterations, stats) <= sub.tolerance) {
+      r = next;
+      residual = natural_map_residual(problem, r);
+      epsilon = std::max(0.1 * epsilon, floor);
+    } else {
+      epsilon = std::min(10.0 * epsilon, ceiling);
+    }
   }
   return r;
 }

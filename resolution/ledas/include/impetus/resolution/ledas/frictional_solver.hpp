@@ -62,8 +62,8 @@ struct FrictionalSettings {
   std::uint64_t hybrid_rounds = 40;      ///< rounds of proximal Newton then Gauss–Seidel sweeps, at most
   std::uint64_t sweeps_per_round = 20;   ///< projected Gauss–Seidel sweeps per round
   double regularization = 1e-10;         ///< W's diagonal shift in the Jacobian, × max W_ii
-  double proximal = 1e-6;                ///< the proximal stage's first ε, × max W_ii
-  std::uint64_t proximal_iterations = 8;  ///< proximal points per round at most
+  double proximal = 1e-3;                ///< the proximal stage's first ε, × max W_ii
+  std::uint64_t proximal_iterations = 40; ///< proximal points per round at most
   /// Newton steps per proximal point: near a solution Newton converges in a few; more means it is not
   /// near one yet, and Gauss–Seidel sweeps take over again.
   std::uint64_t proximal_newton_iterations = 10;

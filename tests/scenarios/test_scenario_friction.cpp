@@ -1,0 +1,180 @@
+// Coulomb friction end to end (docs/conventions.md, "Friction"): the bundled friction scenes
+// (assets/scenes/friction_*.yaml) stepped through the real plugins and compared with closed forms.
+#include "scenario_support.hpp"
+
+#include "impetus/core/error.hpp"
+
+#include <cmath>
+#include <cstdio>
+#include <string>
+#include <vector>
+
+namespace impetus::scenario {
+namespace {
+
+constexpr double kSlope = 30.0 * M_PI / 180.0;  // the slope of the friction scenes (gravity tilted about y)
+constexpr double kG = 9.81;
+
+std::string number(double x) {
+  char text[40];
+  std::snprintf(text, sizeof(text), "%.17g", x);
+  return text;
+}
+
+std::string vec(const Vec3& v) { return "[" + number(v.x()) + ", " + number(v.y()) + ", " + number(v.z()) + "]"; }
+
+// Gravity of a slope of `angle` whose downhill direction is at `yaw` about z (the ground stays z = 0).
+Vec3 slope_gravity(double angle, double yaw) {
+  return kG * Vec3(std::sin(angle) * std::cos(yaw), std::sin(angle) * std::sin(yaw), -std::cos(angle));
+}
+
+// Steps `run` `steps` times, failing on a step that is not ok or leaves the friction problem unsolved.
+void step(SceneRun& run, int steps) {
+  for (int i = 0; i < steps; ++i) {
+    const StepStatus& status = run.world->step();
+    ASSERT_TRUE(status.ok) << status.message;
+    ASSERT_EQ(status.resolver.non_converged, 0u) << "step " << i;
+  }
+}
+
+// The friction scenes run with both resolvers that model friction.
+class FrictionScene : public ::testing::TestWithParam<const char*> {
+ protected:
+  void SetUp() override { IMPETUS_REQUIRE_PLUGINS({"detector", "fcl"}, {"resolver", GetParam()}); }
+  std::vector<SceneOverride> with(std::vector<SceneOverride> more) const {
+    more.push_back({"modules.resolver", GetParam()});
+    return more;
+  }
+};
+
+// A box with contact μ = 0.5 < tan 30° slides down the slope with a = g (sin θ − μ cos θ); the velocity
+// after 1 s matches a·t to 1e-9 relative (split step: the velocity is exact step by step).
+TEST_P(FrictionScene, BoxSlidesDownTheSlopeWithCoulombDeceleration) {
+  SceneRun run("friction_slope.yaml", with({}));
+  step(run, 1000);
+  const double a = kG * (std::sin(kSlope) - 0.5 * std::cos(kSlope));
+  const Vec3 v = run.body("box").velocity;
+  EXPECT_NEAR(v.x(), a * 1.0, 1e-9 * a);
+  EXPECT_NEAR(v.y(), 0.0, 1e-12);
+  EXPECT_NEAR(v.z(), 0.0, 1e-9);
+}
+
+// Isotropy: the same slope with its downhill direction turned by 37° about the normal (the box keeps
+// its yaw, so the slip runs across its edges and contacts differently): the speed along the slope
+// equals the unturned one to 1e-12 relative and nothing moves across it.
+TEST_P(FrictionScene, SlidingDoesNotDependOnTheDirectionOfTheSlope) {
+  const double yaw = 37.0 * M_PI / 180.0;
+  SceneRun straight("friction_slope.yaml", with({}));
+  SceneRun turned("friction_slope.yaml", with({{"gravity", vec(slope_gravity(kSlope, yaw))}}));
+  step(straight, 500);
+  step(turned, 500);
+  const Vec3 downhill(std::cos(yaw), std::sin(yaw), 0.0), across(-std::sin(yaw), std::cos(yaw), 0.0);
+  const double reference = straight.body("box").velocity.x();
+  const Vec3 v = turned.body("box").velocity;
+  EXPECT_NEAR(v.dot(downhill), reference, 1e-12 * reference);
+  EXPECT_NEAR(v.dot(across), 0.0, 1e-12 * reference);
+}
+
+// μ = 0.7 > tan 30°: the box sticks; over 5 s it moves by less than 1e-9 m (no creep).
+TEST_P(FrictionScene, BoxSticksAboveTheFrictionAngle) {
+  SceneRun run("friction_slope.yaml", with({{"bodies.box.friction", "0.7"}, {"bodies.ground.friction", "0.7"}}));
+  const Vec3 start = run.body("box").position;
+  step(run, 5000);
+  EXPECT_LT((run.body("box").position - start).norm(), 1e-9);
+}
+
+// Box2D's friction ramp: of five boxes on one 30° slope, μ = 0.1, 0.3, 0.5 slide with the closed-form
+// acceleration (1e-9 relative) and μ = 0.6, 0.8 stick (1e-9 m).
+TEST_P(FrictionScene, RampSortsStickingFromSlidingBoxes) {
+  SceneRun run("friction_ramp.yaml", with({}));
+  const std::vector<std::pair<std::string, double>> boxes = {
+      {"box_mu01", 0.1}, {"box_mu03", 0.3}, {"box_mu05", 0.5}, {"box_mu06", 0.6}, {"box_mu08", 0.8}};
+  std::vector<Vec3> start;
+  for (const auto& [name, mu] : boxes) start.push_back(run.body(name).position);
+  step(run, 1000);
+  for (std::size_t i = 0; i < boxes.size(); ++i) {
+    const auto& [name, mu] = boxes[i];
+    const RigidBody& b = run.body(name);
+    if (mu < std::tan(kSlope)) {
+      const double a = kG * (std::sin(kSlope) - mu * std::cos(kSlope));
+      EXPECT_NEAR(b.velocity.x(), a, 1e-9 * a) << name;
+    } else {
+      EXPECT_LT((b.position - start[i]).norm(), 1e-9) << name;
+    }
+  }
+}
+
+// A solid sphere thrown sliding without spin (v0 = 2 m/s, μ = 0.2): it decelerates at μ g until
+// t* = 2 v0 / (7 μ g), then rolls at exactly 5/7 v0 with ω r = v (1e-9 relative).
+TEST_P(FrictionScene, ThrownSphereSlidesThenRollsAtFiveSevenths) {
+  SceneRun run("friction_sphere.yaml", with({}));
+  const double v0 = 2.0, mu = 0.2, radius = 0.1, dt = run.world->settings().dt;
+  const double t_roll = 2.0 * v0 / (7.0 * mu * kG);
+  const int sliding_steps = static_cast<int>(std::floor(t_roll / dt)) - 1;
+  step(run, sliding_steps);
+  EXPECT_NEAR(run.body("ball").velocity.x(), v0 - mu * kG * sliding_steps * dt, 1e-9 * v0);
+  step(run, 1000 - sliding_steps);
+  const RigidBody& ball = run.body("ball");
+  EXPECT_NEAR(ball.velocity.x(), 5.0 / 7.0 * v0, 1e-9 * v0);
+  EXPECT_NEAR(ball.angular_velocity.y() * radius, ball.velocity.x(), 1e-9 * v0);
+}
+
+// A sphere released on a 30° slope rolls with a = 5/7 g sin θ when μ ≥ 2/7 tan θ ≈ 0.165 (here 0.2),
+// and slips with a = g (sin θ − μ cos θ) when μ is below it (here 0.1); 1e-9 relative after 0.5 s.
+TEST_P(FrictionScene, SphereRollsDownTheSlopeOrSlipsBelowTwoSeventhsTan) {
+  for (const double mu : {0.2, 0.1}) {
+    SceneRun run("friction_sphere.yaml", with({{"gravity", vec(slope_gravity(kSlope, 0.0))},
+                                               {"bodies.ball.velocity", "[0, 0, 0]"},
+                                               {"bodies.ball.friction", number(mu)},
+                                               {"bodies.ground.friction", number(mu)}}));
+    step(run, 500);
+    const double a = mu >= 2.0 / 7.0 * std::tan(kSlope) ? 5.0 / 7.0 * kG * std::sin(kSlope)
+                                                          : kG * (std::sin(kSlope) - mu * std::cos(kSlope));
+    EXPECT_NEAR(run.body("ball").velocity.x(), a * 0.5, 1e-9 * a) << "mu " << mu;
+  }
+}
+
+INSTANTIATE_TEST_SUITE_P(Resolvers, FrictionScene, ::testing::Values("ledas"),
+                         [](const ::testing::TestParamInfo<const char*>& info) { return std::string(info.param); });
+
+// Ten boxes stacked with μ = 0.5 stand for 60 s at 60 Hz: no body moves by 1 mm, no penetration
+// beyond the detector's margin; and the same on a 4° slope (below the friction angle atan 0.5 ≈ 26.6°
+// and below the angle atan(0.5 / 5) ≈ 5.7° at which the whole stack would tip over its lower edge).
+TEST(ScenarioFriction, StackOfTenStandsOnFlatGroundAndOnASlope) {
+  IMPETUS_REQUIRE_PLUGINS({"detector", "fcl"}, {"resolver", "ledas"});
+  for (const double angle : {0.0, 4.0 * M_PI / 180.0}) {  // 60 s flat, 20 s on the slope
+    SceneRun run("friction_stack_10.yaml", {{"gravity", vec(slope_gravity(angle, 0.0))}});
+    std::vector<Vec3> start;
+    for (const RigidBody& b : run.world->bodies()) start.push_back(b.position);
+    double penetration = 0.0;
+    for (int i = 0; i < (angle == 0.0 ? 3600 : 1200); ++i) {
+      const StepStatus& status = run.world->step();
+      ASSERT_TRUE(status.ok) << status.message;
+      ASSERT_EQ(status.resolver.non_converged, 0u);
+      penetration = std::max(penetration, measure(*run.world).max_penetration);
+    }
+    double drift = 0.0;
+    for (std::size_t i = 0; i < start.size(); ++i)
+      drift = std::max(drift, (run.world->bodies()[i].position - start[i]).norm());
+    std::printf("[ scenario ] friction stack 10, slope %.0f deg: drift %.3g m, penetration %.3g m\n",
+                angle * 180.0 / M_PI, drift, penetration);
+    EXPECT_LT(drift, 1e-3);
+    EXPECT_LT(penetration, 1e-3);
+  }
+}
+
+// A scene with friction and a resolver that does not model it is an error naming friction (ledas's
+// paper mode has no friction formulas); it is never silently ignored.
+TEST(ScenarioFriction, ResolverWithoutFrictionIsRefused) {
+  IMPETUS_REQUIRE_PLUGINS({"detector", "fcl"}, {"resolver", "ledas"});
+  try {
+    SceneRun run("friction_slope.yaml", {{"modules.resolver.mode", "paper"}});
+    FAIL() << "paper mode accepted a scene with friction";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("friction"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("'ground'"), std::string::npos) << e.what();
+  }
+}
+
+}  // namespace
+}  // namespace impetus::scenario
