@@ -120,7 +120,8 @@ struct GoldenCase {
   std::string key() const { return scene + " " + resolver + " " + std::to_string(steps); }
 };
 
-// The cases, in file order. Scenes are chosen to cover spheres, boxes (manifolds), meshes and joints.
+// The cases, in file order. Scenes are chosen to cover spheres, boxes (manifolds), meshes, joints and friction
+// (sliding and sticking boxes, a stack, a sphere that slides then rolls).
 const std::vector<GoldenCase>& golden_cases() {
   static const std::vector<GoldenCase> cases = {
       {"pyramid_drop_10", "ledas", 200},  {"pyramid_drop_10", "ledas_paper", 200},
@@ -129,6 +130,8 @@ const std::vector<GoldenCase>& golden_cases() {
       {"newtons_cradle_5", "ledas", 400},  {"newtons_cradle_5", "ledas_paper", 400},
       {"newtons_cradle_5", "mirtich", 400}, {"meshes_drop", "ledas", 300},
       {"meshes_drop", "mirtich", 300},     {"pendulum_chain", "ledas", 300},
+      {"friction_ramp", "ledas", 300},     {"friction_stack_10", "ledas", 100},
+      {"friction_sphere", "ledas", 400},
   };
   return cases;
 }

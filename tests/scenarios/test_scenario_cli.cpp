@@ -7,6 +7,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <cmath>
 #include <cstdio>
 
 namespace impetus::scenario {
@@ -64,6 +65,35 @@ TEST(ScenarioCli, ResolveBilliardsWithTheSequentialResolver) {
   EXPECT_GE(j["iterations"].get<std::uint64_t>(), 2u);
   for (const auto& c : j["contacts"]) EXPECT_GE(c["impulse"].get<double>(), 0.0) << c.dump();
   EXPECT_EQ(j["bodies"].size(), 3u);
+}
+
+// `impetus resolve friction_slope.yaml --json` with the box moving at (1, 0, −0.1) m/s: its four corner
+// contacts slide; each prints its tangential impulse (⊥ normal, pointing uphill, within the cone ‖p_t‖ ≤ μ p_n,
+// on it to 1e-9 since the box slides) and mode "slide"; the resolve prints its natural-map residual
+// (≤ 1e-12) and the friction counts.
+TEST(ScenarioCli, ResolvePrintsTangentialImpulsesAndModes) {
+  IMPETUS_REQUIRE_PLUGINS({"detector", "fcl"}, {"resolver", "ledas"});
+  const Result r = run_impetus("resolve " + scene_path("friction_slope.yaml") +
+                                 " --json --set \"bodies.box.velocity=[1, 0, -0.1]\"");
+  ASSERT_EQ(r.status, 0) << r.out << r.err;
+  const auto j = nlohmann::json::parse(r.out);
+  ASSERT_EQ(j["contacts"].size(), 4u) << r.out;
+  double normal = 0.0;
+  for (const auto& c : j["contacts"]) {
+    const auto t = c["tangent_impulse"].get<std::vector<double>>();
+    const auto n = c["normal"].get<std::vector<double>>();
+    const double p = c["impulse"].get<double>(), pt = std::hypot(t[0], t[1], t[2]);
+    normal += p;
+    EXPECT_EQ(c["mode"], "slide") << c.dump();
+    EXPECT_NEAR(t[0] * n[0] + t[1] * n[1] + t[2] * n[2], 0.0, 1e-15) << c.dump();
+    EXPECT_NEAR(pt, 0.5 * p, 1e-9 * p) << c.dump();
+    EXPECT_LT(t[0], 0.0) << "friction on the box opposes its slip: " << c.dump();
+  }
+  EXPECT_GT(normal, 0.0);
+  EXPECT_LE(j["natural_map_residual"].get<double>(), 1e-12);
+  EXPECT_EQ(j["sliding"].get<std::uint64_t>(), 4u);
+  EXPECT_EQ(j["sticking"].get<std::uint64_t>(), 0u);
+  EXPECT_LT(j["friction_work_j"].get<double>(), 0.0);
 }
 
 // `impetus run box_stack_10.yaml --resolver mirtich` finishes (the sequential resolver caps its work
