@@ -76,7 +76,14 @@ void LedasResolver::velocity_frictional(ledas::Island& island, std::span<RigidBo
     const bool refine = ledas::retarget_joints(island, rows_, info_, v, bodies);
     if (round > 0 && !refine) break;
     if (round == 0 && !needed && !refine) return;
-    const Vector r = solve_frictional(island, v - island.target);
+    const std::uint64_t failures = stats_.friction.non_converged;
+    Vector r = solve_frictional(island, v - island.target);
+    // A problem left unsolved (counted) still must not create energy: its best iterate is scaled back
+    // so that ΔE = rᵀv + ½ rᵀA r ≤ 0 (rows' velocities v before it).
+    if (stats_.friction.non_converged != failures) {
+      const double linear = r.dot(v), quadratic = 0.5 * r.dot(island.a * r);
+      if (linear + quadratic > 0.0) r *= linear < 0.0 && quadratic > 0.0 ? std::min(1.0, -linear / quadratic) : 0.0;
+    }
     for (std::size_t i = 0; i < m; ++i)
       if (r(static_cast<Eigen::Index>(i)) != 0.0 && island.normal_row(i)) island.entered[i] = 1;
     island.impulse_inelastic += r;

@@ -273,8 +273,9 @@ double FrictionalSolver::newton(const FrictionalProblem& problem, const std::vec
   std::vector<Linearization> lin, lin_trial;
   evaluate(blocks, r, u, f, lin);
   double merit = 0.5 * f.squaredNorm();
-  for (std::uint64_t it = 0; it < iterations && best_residual > problem.tolerance; ++it) {
+  for (std::uint64_t it = 0; it < iterations && best_residual > problem.tolerance && steps_left_ > 0; ++it) {
     ++stats.newton_steps;
+    --steps_left_;
     const Vector d = newton_direction(blocks, lin, w, shift, f, settings_.dense_limit);
     if (d.size() == 0) {
       ++stats.nan_caught;
@@ -325,7 +326,8 @@ Vector FrictionalSolver::proximal_newton(const FrictionalProblem& problem, const
   FrictionalProblem sub;
   sub.role = problem.role;
   sub.mu = problem.mu;
-  for (std::uint64_t outer = 0; outer < settings_.proximal_iterations && residual > problem.tolerance; ++outer) {
+  for (std::uint64_t outer = 0; outer < settings_.proximal_iterations && residual > problem.tolerance && steps_left_ > 0;
+       ++outer) {
     ++stats.proximal_steps;
     if (epsilon != shifted_by) {
       shifted = *problem.w;
@@ -353,6 +355,7 @@ Vector FrictionalSolver::solve(const FrictionalProblem& problem, FrictionalStats
   const Vector diagonal = w.diagonal();
   const std::vector<Block> blocks = make_blocks(problem, diagonal);
   ++stats.problems;
+  steps_left_ = settings_.max_newton_steps;
 
   // 1. Newton on the problem itself, from r = 0: enough whenever W is well conditioned on the contacts
   //    that end up pressed.
@@ -367,7 +370,8 @@ Vector FrictionalSolver::solve(const FrictionalProblem& problem, FrictionalStats
   //    (robust, slow; it brings the iterate nearer a solution) before the next try.
   Vector best = r;
   double best_residual = residual;
-  for (std::uint64_t round = 0; round < settings_.hybrid_rounds && best_residual > problem.tolerance; ++round) {
+  for (std::uint64_t round = 0;
+       round < settings_.hybrid_rounds && best_residual > problem.tolerance && steps_left_ > 0; ++round) {
     r = proximal_newton(problem, blocks, best, stats);
     if (const double now = natural_map_residual(problem, r); now < best_residual) {
       best_residual = now;

@@ -58,7 +58,10 @@ struct FrictionalProblem {
 /// How frictional problems are solved (configuration).
 struct FrictionalSettings {
   std::size_t dense_limit = 96;          ///< Jacobians of at most this many rows are factorized dense
-  std::uint64_t newton_iterations = 60;  ///< Newton steps per attempt (two attempts around the fallback)
+  std::uint64_t newton_iterations = 60;  ///< Newton steps of the first attempt
+  /// Newton steps per problem at most, over all stages: bounds the work of a problem the method cannot
+  /// solve (then the best iterate is returned and counted in non_converged).
+  std::uint64_t max_newton_steps = 300;
   std::uint64_t hybrid_rounds = 40;      ///< rounds of proximal Newton then Gauss–Seidel sweeps, at most
   std::uint64_t sweeps_per_round = 20;   ///< projected Gauss–Seidel sweeps per round
   double regularization = 1e-10;         ///< W's diagonal shift in the Jacobian, × max W_ii
@@ -110,6 +113,7 @@ class FrictionalSolver {
                          FrictionalStats& stats);
 
   FrictionalSettings settings_;
+  std::uint64_t steps_left_ = 0;  // Newton steps left to the current solve (max_newton_steps)
 };
 
 }  // namespace impetus::ledas
