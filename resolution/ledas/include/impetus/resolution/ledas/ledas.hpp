@@ -99,6 +99,12 @@ struct LedasStats {
 /// with resolution::apply_row_displacement (no velocity change). Contact::impulse gets each contact's
 /// total impulse Σ (1 + e) p (N·s).
 ///
+/// Friction (complementary mode; resolution/ledas/README.md, "Friction"): a contact with μ > 0 adds two
+/// tangent rows after its normal row, and its island's velocity phase is the frictional contact problem
+/// (frictional_solver.hpp) in two phases, inelastic then restitution capped at the pre-impact energy;
+/// Contact::tangent_impulse and Contact::mode are written for every contact. The position correction
+/// acts along normals only.
+///
 /// Gap contacts (depth < 0, within the detector's margin) are speculative: a gap contact takes part only
 /// if it would close within the step (v_n·dt < depth) and then asks v_n⁺ ≥ depth/dt, so the gap closes
 /// exactly at the end of the step; with restitution (e > 0 after the bounce threshold) it asks v_n⁺ ≥ 0
