@@ -42,7 +42,7 @@ double cross2(const Vec2& a, const Vec2& b) { return a.x() * b.y() - a.y() * b.x
 enum class Phase { compression, restitution, done };
 enum class SlipState { sliding, sticking, ray };
 
-// The integration of one collision (sec. 4.3–4.5). Each member function advances `y` by one step.
+// The integration of one collision (thesis ch. 4). Each member function advances `y` by one step.
 class ImpactIntegrator {
  public:
   ImpactIntegrator(const Mat3& k_local, const Vec3& u_local, double mu, double e, const FrictionalImpactLimits& limits)
@@ -100,13 +100,13 @@ class ImpactIntegrator {
     if (mu_ == 0.0) return straight_segment(Vec2::Zero(), false);  // the rate does not depend on û
     if (slip_speed == 0.0) return on_slip_zero();
     const Vec2 dir = ut / slip_speed;
-    const Vec2 dut = ktn_ - mu_ * ktt_ * dir;  // du_t/dp_n while sliding along û (sec. 4.3)
+    const Vec2 dut = ktn_ - mu_ * ktt_ * dir;  // du_t/dp_n while sliding along û (thesis ch. 4)
     if (std::abs(cross2(dir, dut)) <= kStraight * dut.norm() || slip_speed <= kSlipSnap * speed_)
       return straight_segment(-mu_ * dir, true);
     rk4_step();
   }
 
-  // The derivative of the state in p_n while sliding (Mirtich's sliding equations, sec. 4.3):
+  // The derivative of the state in p_n while sliding (Mirtich's sliding equations, thesis ch. 4):
   // du/dp_n = K (n − μ û), dp_t/dp_n = −μ û, dW_n/dp_n = u_n, dW_t/dp_n = u_t·dp_t/dp_n = −μ ‖u_t‖.
   State rate(const State& y) const {
     const Vec2 ut = y.segment<2>(kUt);
@@ -259,7 +259,7 @@ class ImpactIntegrator {
     phase_ = e_ > 0.0 && compression_work_ < 0.0 ? Phase::restitution : Phase::done;
   }
 
-  // The slip has reached zero (sec. 4.4). Sticking holds if the impulse direction that keeps
+  // The slip has reached zero (thesis ch. 4). Sticking holds if the impulse direction that keeps
   // u_t ≡ 0, (d_t, 1) with K_tt d_t + K_tn = 0, is inside the cone; then du_n/dp_n = 1/(nᵀK⁻¹n) > 0 and
   // it holds to the end of the collision. Otherwise the slip restarts along the invariant direction
   // that diverges from zero.
@@ -282,7 +282,7 @@ class ImpactIntegrator {
   }
 
   // The unit û with K_tn − μ K_tt û = λ û, λ > 0: a slip started from zero along û stays along û and
-  // grows (the slip-reversal direction of sec. 4.4). The roots of û × (K_tn − μ K_tt û) over the angle
+  // grows (the slip-reversal direction of thesis ch. 4). The roots of û × (K_tn − μ K_tt û) over the angle
   // are bracketed on kRaySamples angles and bisected; of several, the one with the largest λ (the
   // fastest-growing, deterministic).
   bool find_diverging_ray() {
@@ -341,7 +341,7 @@ class ImpactIntegrator {
 
 Mat3 collision_matrix(const RigidBody& a, const RigidBody& b, const Vec3& point) {
   // An impulse P at r = point − x changes u = v + ω × r by P/m + (J⁻¹ (r × P)) × r = (1/m − [r]ₓ J⁻¹ [r]ₓ) P
-  // (sec. 4.2); body a receives −P and enters u = u_b − u_a with a minus sign, so both add.
+  // (thesis ch. 4); body a receives −P and enters u = u_b − u_a with a minus sign, so both add.
   Mat3 k = Mat3::Zero();
   for (const RigidBody* body : {&a, &b}) {
     if (body->fixed) continue;

@@ -4,16 +4,16 @@
 /// "Impulse-based Dynamic Simulation of Rigid Body Systems", PhD thesis, UC Berkeley 1996, ch. 4).
 /// See resolution/mirtich/README.md for the derivation; in short:
 ///
-/// - The collision matrix K (sec. 4.2) maps a world impulse P applied +P on b, −P on a at the contact
+/// - The collision matrix K (thesis ch. 4) maps a world impulse P applied +P on b, −P on a at the contact
 ///   point to the change of the relative contact velocity u = u_b − u_a:
 ///     K = (1/m_a + 1/m_b) I − [r_a]ₓ J_a⁻¹ [r_a]ₓ − [r_b]ₓ J_b⁻¹ [r_b]ₓ   (fixed bodies contribute nothing).
 /// - During the collision the impulse grows as dP = (n − μ û_t) dp_n while the contact slips (û_t the
-///   unit slip, sec. 4.3), so du/dp_n = K (n − μ û_t). Where the slip direction is constant this is
+///   unit slip), so du/dp_n = K (n − μ û_t). Where the slip direction is constant this is
 ///   linear in p_n and is advanced in closed form; otherwise by adaptive RK4.
 /// - When the slip reaches zero (found exactly, not by overshooting) the contact sticks if the impulse
 ///   direction that keeps u_t ≡ 0, n + d_t with d_t = −K_tt⁻¹ K_tn, lies inside the friction cone
 ///   (‖d_t‖ ≤ μ); otherwise it slides on along the diverging invariant direction û with
-///   K_t (n − μ û) = λ û, λ > 0 (slip reversal, sec. 4.4).
+///   K_t (n − μ û) = λ û, λ > 0 (slip reversal).
 /// - Compression ends at u_n = 0. Restitution uses Stronge's energetic coefficient: the restitution
 ///   phase ends when the work of the normal impulse in it equals e² times minus its work in
 ///   compression. Newton's (u_n⁺ = −e u_n⁻) and Poisson's (p = (1 + e) p_c) rules can create energy
@@ -27,7 +27,7 @@
 namespace impetus::mirtich {
 
 /// K: the change of the relative velocity u_b − u_a at `point` per unit world impulse (+P on b, −P on
-/// a), kg⁻¹ (Mirtich 1996, sec. 4.2). Symmetric positive semi-definite; zero if both bodies are fixed.
+/// a), kg⁻¹ (Mirtich 1996, ch. 4). Symmetric positive semi-definite; zero if both bodies are fixed.
 Mat3 collision_matrix(const RigidBody& a, const RigidBody& b, const Vec3& point);
 
 /// Bounds of the integration.
