@@ -43,9 +43,6 @@ struct Workspace {
   }
 };
 
-// Applies the single-contact impulse at row k, which approaches with v_n = ws.vn[k] < 0, and refreshes
-// v_n of every row that shares a body with it (recomputed from the velocities, so no drift builds up).
-// Returns false (and applies nothing) if the impulse is not finite.
 // Refreshes v_n of every row that shares a movable body with row k (recomputed from the velocities).
 void refresh_neighbours(std::uint32_t k, Workspace& ws, std::span<const RigidBody> bodies) {
   for (const std::int32_t s : ws.incidence.slots[k])
@@ -77,6 +74,9 @@ bool apply_frictional_impulse(std::uint32_t k, double e, Workspace& ws, std::spa
   return true;
 }
 
+// Applies the single-contact impulse at row k, which approaches with v_n = ws.vn[k] < 0, and refreshes
+// v_n of every row that shares a body with it (recomputed from the velocities, so no drift builds up).
+// Returns false (and applies nothing) if the impulse is not finite.
 bool apply_single_impulse(std::uint32_t k, Workspace& ws, std::span<RigidBody> bodies,
                           const MirtichSettings& settings, ResolverCounters& counters) {
   const ImpulseRow& row = ws.rows[k];
