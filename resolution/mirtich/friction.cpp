@@ -42,7 +42,8 @@ double cross2(const Vec2& a, const Vec2& b) { return a.x() * b.y() - a.y() * b.x
 enum class Phase { compression, restitution, done };
 enum class SlipState { sliding, sticking, ray };
 
-// The integration of one collision (thesis ch. 4). Each member function advances `y` by one step.
+// The integration of one collision (thesis ch. 4): run() calls step() until the collision ends, each
+// step one closed-form segment or one (possibly rejected) RK4 step.
 class ImpactIntegrator {
  public:
   ImpactIntegrator(const Mat3& k_local, const Vec3& u_local, double mu, double e, const FrictionalImpactLimits& limits)
