@@ -1,6 +1,7 @@
 #include "impetus/resolution/mirtich/mirtich.hpp"
 
 #include "impetus/resolution/common/incidence.hpp"
+#include "impetus/resolution/mirtich/friction.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -23,6 +24,9 @@ struct Workspace {
   std::vector<double> vn;        // current v_n of each row (m/s), refreshed after every impulse
   std::vector<double> impulse;   // accumulated p ≥ 0 (N·s)
   std::vector<char> usable;      // false for rows whose A_kk is not a finite positive number
+  std::vector<double> mu;        // Coulomb coefficient of each contact (combined_friction)
+  std::vector<Vec3> tangent;     // accumulated tangential impulse p_t (N·s, world)
+  std::span<const Contact> contacts;
   resolution::Incidence incidence;  // rows ↔ movable bodies (slot = body index; fixed bodies: none)
   std::vector<std::size_t> local;  // row → its position in the island being corrected
 
@@ -39,6 +43,37 @@ struct Workspace {
   }
 };
 
+// Refreshes v_n of every row that shares a movable body with row k (recomputed from the velocities).
+void refresh_neighbours(std::uint32_t k, Workspace& ws, std::span<const RigidBody> bodies) {
+  for (const std::int32_t s : ws.incidence.slots[k])
+    for (std::uint32_t i : ws.incidence.rows_of(s)) ws.vn[i] = resolution::row_velocity(ws.rows[i], bodies);
+}
+
+// The frictional single-contact impulse at contact k (μ > 0): Mirtich's integration of the collision
+// in p_n (friction.hpp) from the current relative velocity, with Stronge's coefficient `e`; the whole
+// impulse P = p_n n + p_t is applied with apply_contact_impulse. Returns false (and applies nothing)
+// if the integration produced a non-finite number.
+bool apply_frictional_impulse(std::uint32_t k, double e, Workspace& ws, std::span<RigidBody> bodies,
+                              ResolverCounters& counters) {
+  const Contact& c = ws.contacts[k];
+  RigidBody& a = bodies[c.a];
+  RigidBody& b = bodies[c.b];
+  const mirtich::FrictionalImpact impact = mirtich::integrate_frictional_impact(
+      mirtich::collision_matrix(a, b, c.point), relative_velocity(c, a, b), c.normal, ws.mu[k], e);
+  if (!impact.finite || !impact.impulse(c.normal).allFinite()) {
+    ++counters.nan_caught;
+    ws.usable[k] = 0;
+    return false;
+  }
+  if (!impact.converged) ++counters.non_converged;  // the partial impulse integrated so far is applied
+  apply_contact_impulse(c, impact.impulse(c.normal), a, b);
+  ws.impulse[k] += impact.normal_impulse;
+  ws.tangent[k] += impact.tangent_impulse;
+  counters.friction_work += impact.friction_work;
+  refresh_neighbours(k, ws, bodies);
+  return true;
+}
+
 // Applies the single-contact impulse at row k, which approaches with v_n = ws.vn[k] < 0, and refreshes
 // v_n of every row that shares a body with it (recomputed from the velocities, so no drift builds up).
 // Returns false (and applies nothing) if the impulse is not finite.
@@ -49,6 +84,8 @@ bool apply_single_impulse(std::uint32_t k, Workspace& ws, std::span<RigidBody> b
   // one is a separate event (Newton's cradle: the next contact approaches at full speed only after the
   // previous impulse). `ledas` judges the island as a whole instead; see README.md.
   const double e = resolution::effective_restitution(row, -ws.vn[k], settings.resting);
+  if (ws.mu[k] > 0.0) return apply_frictional_impulse(k, e, ws, bodies, counters);
+  // Frictionless: the closed form below (unchanged, so frictionless scenes stay bit-identical).
   const double p = -(1.0 + e) * ws.vn[k] / ws.a_kk[k];
   if (!std::isfinite(p)) {
     ++counters.nan_caught;
@@ -57,8 +94,7 @@ bool apply_single_impulse(std::uint32_t k, Workspace& ws, std::span<RigidBody> b
   }
   resolution::apply_row_impulse(row, p, bodies);
   ws.impulse[k] += p;
-  for (const std::int32_t s : ws.incidence.slots[k])
-    for (std::uint32_t i : ws.incidence.rows_of(s)) ws.vn[i] = resolution::row_velocity(ws.rows[i], bodies);
+  refresh_neighbours(k, ws, bodies);
   return true;
 }
 
@@ -167,6 +203,26 @@ void correct_island(const std::vector<std::uint32_t>& island, Workspace& ws, std
     if (q[j] > 0.0) resolution::apply_row_displacement(ws.rows[island[j]], q[j], bodies);
 }
 
+// Writes each contact's impulses and final mode (before the position correction moves the bodies):
+// separate if it received no impulse, stick if its slip ‖u_t‖ after the sweep is at most `tolerance`,
+// slide otherwise; counts sticking and sliding contacts once each.
+void record_outcomes(const Workspace& ws, std::span<Contact> contacts, std::span<const RigidBody> bodies,
+                     double tolerance, ResolverCounters& counters) {
+  for (std::size_t k = 0; k < contacts.size(); ++k) {
+    Contact& c = contacts[k];
+    c.impulse = ws.impulse[k];
+    c.tangent_impulse = ws.tangent[k];
+    if (ws.impulse[k] == 0.0 && ws.tangent[k].isZero(0.0)) {
+      c.mode = ContactMode::separate;
+      continue;
+    }
+    const Vec3 u = relative_velocity(c, bodies[c.a], bodies[c.b]);
+    const Vec3 slip = u - u.dot(c.normal) * c.normal;
+    c.mode = slip.norm() <= tolerance ? ContactMode::stick : ContactMode::slide;
+    ++(c.mode == ContactMode::stick ? counters.sticking : counters.sliding);
+  }
+}
+
 }  // namespace
 
 MirtichSettings MirtichSettings::from_options(const ModuleOptions& options) {
@@ -203,6 +259,10 @@ void MirtichResolver::resolve(std::span<RigidBody> bodies, std::span<Contact> co
     ws.impulse.assign(m, 0.0);
     ws.usable.assign(m, 1);
     ws.local.assign(m, 0);
+    ws.mu.resize(m);
+    ws.tangent.assign(m, Vec3::Zero());
+    ws.contacts = contacts;
+    for (std::size_t k = 0; k < m; ++k) ws.mu[k] = combined_friction(bodies[contacts[k].a], bodies[contacts[k].b]);
     for (std::uint32_t k = 0; k < m; ++k) {
       const ImpulseRow& row = ws.rows[k];
       ws.a_kk[k] = resolution::self_coupling(row);
@@ -230,8 +290,8 @@ void MirtichResolver::resolve(std::span<RigidBody> bodies, std::span<Contact> co
     const resolution::ContactResidual residual = resolution::measure_residual(ws.rows, ws.impulse, bodies);
     counters.residual = std::max(counters.residual, residual.max_approach);
     counters.complementarity_error = std::max(counters.complementarity_error, residual.complementarity);
+    record_outcomes(ws, contacts, bodies, settings_.tolerance, counters);
     for (const auto& island : islands) correct_island(island, ws, contacts, bodies, settings_);
-    for (std::size_t k = 0; k < m; ++k) contacts[k].impulse = ws.impulse[k];
   } catch (...) {
     // Only allocation can throw here; report it as a failed (non-converged) resolution.
     ++counters.non_converged;

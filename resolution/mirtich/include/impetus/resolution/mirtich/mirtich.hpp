@@ -10,6 +10,12 @@
 /// impulse is
 ///   p_k = −(1 + e_k) v_k / A_kk,
 /// which leaves v_k⁺ = −e_k v_k exactly (the paper's eq. 6 for m = 1, with the restitution of sec. 3.2).
+///
+/// With Coulomb friction (μ = combined_friction > 0 at a contact) the single impulse is instead
+/// Mirtich's frictional collision integrated in the normal impulse (his thesis, ch. 4; friction.hpp):
+/// slide, stick or slip reversal, exact at the slip's zero, with Stronge's energetic restitution
+/// (never Newton's or Poisson's, which can create energy with friction), so no single collision gains
+/// energy for e ≤ 1. A contact with μ = 0 keeps the closed form above, bit for bit.
 
 #include "impetus/modules/options.hpp"
 #include "impetus/modules/resolver.hpp"
@@ -49,18 +55,28 @@ struct MirtichSettings {
   std::uint64_t impulse_cap(std::size_t contacts) const;
 };
 
-/// Sequential frictionless impulses, island by island:
+/// Sequential single-contact impulses, island by island:
 ///  1. velocity sweep: while some contact approaches (v_n < −tolerance) and the island's cap is not
-///     reached, pick one (MirtichOrder) and apply p = −(1 + e) v_n / A_kk with
+///     reached, pick one (MirtichOrder) and apply its single-contact impulse with
 ///     e = effective_restitution(row, −v_n of that contact, resting): each single collision gets its
-///     own impact speed (see resolution/mirtich/README.md for why this differs from `ledas`);
+///     own impact speed (see resolution/mirtich/README.md for why this differs from `ledas`). If μ = 0
+///     the impulse is p = −(1 + e) v_n / A_kk along n; if μ > 0 it is P = p_n n + p_t from
+///     integrate_frictional_impact (e read as Stronge's coefficient);
 ///  2. position correction: Gauss–Seidel on pseudo-impulses q ≥ 0 (projected, accumulated) so that
 ///     A q ≥ correction_target(depth) with complementarity, then apply_row_displacement; velocities are
 ///     not touched by it.
-/// Every applied impulse is ≥ 0, so `pulling_impulses` stays 0. Counters: islands, contacts (in
-/// islands), rounds (= single impulses), non_converged (islands that hit the cap), residual and
+/// Every applied normal impulse is ≥ 0, so `pulling_impulses` stays 0. Counters: islands, contacts (in
+/// islands), rounds (= single impulses), non_converged (islands that hit the cap, and frictional
+/// collisions whose integration hit its step cap or could not end), residual and
 /// complementarity_error (measure_residual after the sweep), nan_caught / singular_systems (contacts
-/// whose A_kk or impulse was not a finite positive number; they are skipped).
+/// whose A_kk or impulse was not a finite positive number; they are skipped), sticking / sliding
+/// (contacts by final mode, once each), friction_work (Σ of the exact ∫ u_t·dp_t of every frictional
+/// collision, ≤ 0). natural_map_residual stays 0: a sequential resolver solves no simultaneous
+/// frictional problem to measure it on.
+///
+/// Each contact receives Contact::impulse (Σ p_n), Contact::tangent_impulse (Σ p_t) and Contact::mode:
+/// separate if it received no impulse, stick if its slip after the sweep is at most `tolerance`, slide
+/// otherwise.
 class MirtichResolver final : public CollisionResolver {
  public:
   /// Reads the options; throws OptionError on a bad value.
@@ -68,8 +84,11 @@ class MirtichResolver final : public CollisionResolver {
   /// Builds the resolver from settings directly (tests, embedding).
   explicit MirtichResolver(const MirtichSettings& settings);
 
+  /// Accepts Coulomb friction (Mirtich's frictional collision integration).
+  ModuleStatus accept_friction() noexcept override { return ModuleStatus::success(); }
+
   /// Resolves `contacts` (constraints are refused by accept_constraints and ignored here), writing
-  /// each contact's total impulse (N·s, ≥ 0) into Contact::impulse.
+  /// each contact's total impulse (N·s, ≥ 0) into Contact::impulse, its tangential impulse and mode.
   void resolve(std::span<RigidBody> bodies, std::span<Contact> contacts,
                std::span<const Constraint> constraints, const StepContext& ctx,
                ResolverCounters& counters) noexcept override;
