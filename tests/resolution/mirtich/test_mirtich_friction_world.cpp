@@ -3,6 +3,7 @@
 // measured figure for README.md).
 #include "impetus/engine/world.hpp"
 #include "impetus/integrators/euler/euler.hpp"
+#include "impetus_test/box_stack_detector.hpp"
 #include "mirtich_test_support.hpp"
 
 #include <cstdio>
@@ -24,41 +25,7 @@ std::unique_ptr<World> make_world(double dt, const Vec3& gravity, const MirtichS
   return world;
 }
 
-// Boxes stacked on the ground (body 0, z ≤ 0), body j resting on body j − 1: every corner of a box
-// closer than the margin to the top face of the one below (or the ground) is a contact, normal along
-// the lower body's z axis.
-class StackDetector final : public CollisionDetector {
- public:
-  explicit StackDetector(double margin) : margin_(margin) {}
-  ModuleStatus set_bodies(std::span<const RigidBody>, std::span<const BodyPair>) noexcept override { return {}; }
-  void detect(std::span<const RigidBody> bodies, const StepContext&, std::vector<Contact>& contacts,
-              DetectorCounters& counters) noexcept override {
-    for (BodyIndex j = 1; j < bodies.size(); ++j) {
-      const RigidBody& upper = bodies[j];
-      const Vec3 half_u = 0.5 * std::get<Box>(upper.shape).size;
-      const RigidBody& lower = bodies[j - 1];
-      for (int corner = 0; corner < 8; ++corner) {
-        const Vec3 local((corner & 1 ? 1 : -1) * half_u.x(), (corner & 2 ? 1 : -1) * half_u.y(),
-                         (corner & 4 ? 1 : -1) * half_u.z());
-        const Vec3 p = upper.position + upper.rotation * local;
-        if (j == 1) {
-          if (p.z() < margin_) contacts.push_back(contact(0, j, p, Vec3::UnitZ(), -p.z()));
-          continue;
-        }
-        const Vec3 half_l = 0.5 * std::get<Box>(lower.shape).size;
-        const Vec3 in_lower = lower.rotation.transpose() * (p - lower.position);
-        const double height = in_lower.z() - half_l.z();
-        if (height < margin_ && height > -half_l.z() && std::abs(in_lower.x()) <= half_l.x() + 1e-9 &&
-            std::abs(in_lower.y()) <= half_l.y() + 1e-9)
-          contacts.push_back(contact(j - 1, j, p, lower.rotation.col(2), -height));
-      }
-    }
-    counters.contacts += contacts.size();
-  }
-
- private:
-  double margin_;
-};
+using ::impetus::test::BoxStackDetector;
 
 struct SlopeRun {
   double velocity = 0.0;      // final down-slope velocity (m/s)
@@ -88,7 +55,7 @@ SlopeRun run_slope(double mu, double seconds, Turning turning) {
     cube.inv_inertia_body *= 1e-12;
   }
   world->add_body(cube);
-  world->set_detector(std::make_shared<StackDetector>(1e-3));
+  world->set_detector(std::make_shared<BoxStackDetector>(1e-3));
   const Vec3 start = world->bodies()[1].position;
   SlopeRun run;
   const int steps = static_cast<int>(std::lround(seconds / 1e-3));
@@ -171,7 +138,7 @@ TEST(MirtichFrictionWorld, DISABLED_FrictionalStackDriftIsMeasured) {
       world->add_body(cube);
       z += size - overlap;
     }
-    world->set_detector(std::make_shared<StackDetector>(1e-3));
+    world->set_detector(std::make_shared<BoxStackDetector>(1e-3));
     std::vector<Vec3> start;
     for (const RigidBody& b : world->bodies()) start.push_back(b.position);
     double drift = 0.0, deepest = 0.0, moved = 0.0;
