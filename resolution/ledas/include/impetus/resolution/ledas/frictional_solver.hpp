@@ -20,11 +20,12 @@
 /// generalized Jacobian's system by LU (dense up to `dense_limit` rows, sparse above, W shifted by
 /// `regularization` × max W_ii so redundant contact sets stay solvable), with an Armijo line search on
 /// ½‖F‖². The error is fclib's natural-map residual ‖r − P_K(r − (u + μ‖u_t‖ e_n))‖ (ρ = 1, no scaling).
-/// If Newton stalls (redundant contacts make W singular and the impulses non-unique), proximal points
-/// take over: the same Newton on u = (W + εI) r + q − ε r̄, r̄ moved to each solution, ε shrinking. If
-/// that fails too, a projected Gauss–Seidel on the cones from the best iterate, then Newton again;
-/// whatever happens, the iterate with the smallest residual is returned and a failure to reach the
-/// tolerance is counted, never hidden.
+/// Redundant contacts (more rows than `dofs`: W singular, the impulses not unique) or a stalled Newton:
+/// proximal points take over — the same Newton on u = (W + εI) r + q − ε r̄, r̄ moved to each solution, ε
+/// divided by 10 after a solved subproblem and multiplied by 10 after an unsolved one — alternating with
+/// rounds of projected Gauss–Seidel sweeps on the cones when they stall. At most `max_newton_steps` Newton
+/// steps per problem; whatever happens, the iterate with the smallest residual is returned and a failure
+/// to reach the tolerance is counted, never hidden.
 
 #include "impetus/resolution/ledas/island_solver.hpp"
 
