@@ -3,6 +3,9 @@
 // residual as the error.
 #include "impetus/resolution/ledas/frictional_solver.hpp"
 
+#include "cone_qp.hpp"
+
+#include <Eigen/Eigenvalues>
 #include <Eigen/LU>
 #include <Eigen/SparseLU>
 
@@ -18,7 +21,11 @@ struct FrictionalSolver::Block {
   int size = 1;  // 1 (joint row, frictionless contact) or 3 (normal, t1, t2)
   RowRole role = RowRole::normal;
   double mu = 0.0;
-  double rho_n = 1.0, rho_t = 1.0;  // the Alart–Curnier weights: 1/W_nn and 2/(W_t1t1 + W_t2t2)
+  // The weights: Alart–Curnier's 1/W_nn and 2/(W_t1t1 + W_t2t2) for Coulomb's problem; for the convex
+  // relaxation one weight for the contact's three rows, 1/λ_max of its 3 × 3 block of W (the cone is
+  // projected on as a whole, so the weight must be the same along n and t).
+  double rho_n = 1.0, rho_t = 1.0;
+  bool convex = false;  // the relaxation's cone complementarity r ∈ K, u ∈ K*, r ⊥ u (no De Saxcé shift)
 };
 
 namespace {
@@ -30,18 +37,29 @@ constexpr double kShortestStep = 1e-10;
 using Block = FrictionalSolver::Block;
 
 
-// How the Alart–Curnier function is linearized at the current iterate, per block.
+// How the Alart–Curnier function (or, for the relaxation, the natural map) is linearized at the current
+// iterate, per block.
 enum class Piece : std::uint8_t {
-  open,    // z_n ≤ 0 (separating): F = r
+  open,    // z_n ≤ 0 (separating), or z in the cone's polar: F = r
   active,  // F = ρ u on every row (a joint row, a pressed frictionless contact, a sticking contact)
-  slide    // normal row ρ_n u_n, tangent rows r_t − μ z_n ẑ_t
+  slide,   // normal row ρ_n u_n, tangent rows r_t − μ z_n ẑ_t
+  surface  // relaxation: F = r − P_K(z) with z projected on the cone's surface
 };
 
 struct Linearization {
   Piece piece = Piece::open;
-  double dir1 = 0.0, dir2 = 0.0;  // slide: ẑ_t
-  double ratio = 0.0;             // slide: c = μ z_n / ‖z_t‖ (< 1)
+  double dir1 = 0.0, dir2 = 0.0;  // slide, surface: ẑ_t
+  double ratio = 0.0;             // slide: c = μ z_n / ‖z_t‖ (< 1); surface: μ s / ‖z_t‖
 };
+
+// The largest eigenvalue of the symmetric 3 × 3 block of W at rows first .. first + 2.
+double block_largest_eigenvalue(const SparseMatrix& w, Eigen::Index first) {
+  Eigen::Matrix3d block = Eigen::Matrix3d::Zero();
+  for (int c = 0; c < 3; ++c)
+    for (SparseMatrix::InnerIterator it(w, first + c); it; ++it)
+      if (it.row() >= first && it.row() < first + 3) block(it.row() - first, c) = it.value();
+  return Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(block, Eigen::EigenvaluesOnly).eigenvalues().maxCoeff();
+}
 
 std::vector<Block> make_blocks(const FrictionalProblem& problem, const Vector& diagonal) {
   const auto m = problem.q.size();
@@ -62,7 +80,11 @@ std::vector<Block> make_blocks(const FrictionalProblem& problem, const Vector& d
       b.mu = mu;
     }
     b.rho_n = diagonal(i) > 0.0 ? 1.0 / diagonal(i) : 1.0;
-    if (b.size == 3) {
+    if (b.size == 3 && problem.convex) {
+      b.convex = true;
+      const double largest = block_largest_eigenvalue(*problem.w, i);
+      b.rho_n = b.rho_t = largest > 0.0 ? 1.0 / largest : 1.0;
+    } else if (b.size == 3) {
       const double trace = diagonal(i + 1) + diagonal(i + 2);
       b.rho_t = trace > 0.0 ? 2.0 / trace : b.rho_n;
     }
@@ -72,7 +94,34 @@ std::vector<Block> make_blocks(const FrictionalProblem& problem, const Vector& d
   return blocks;
 }
 
-// F (the Alart–Curnier function) at r with u = W r + q, and how each block is linearized there.
+// The relaxation's block of F = r − P_K(z), z = r − ρ u, and its piece.
+void evaluate_cone(const Block& b, const Vector& r, const Vector& u, Vector& f, Linearization& l) {
+  const Eigen::Index n = b.first;
+  const double zn = r(n) - b.rho_n * u(n), z1 = r(n + 1) - b.rho_t * u(n + 1), z2 = r(n + 2) - b.rho_t * u(n + 2);
+  const double norm = std::hypot(z1, z2);
+  if (norm <= b.mu * zn) {  // inside: F = ρ u
+    l.piece = Piece::active;
+    for (int j = 0; j < 3; ++j) f(n + j) = b.rho_n * u(n + j);
+    return;
+  }
+  if (b.mu * norm <= -zn) {  // in the polar cone: P_K(z) = 0
+    l.piece = Piece::open;
+    for (int j = 0; j < 3; ++j) f(n + j) = r(n + j);
+    return;
+  }
+  // On the surface: P_K(z) = (s, μ s ẑ_t), s = (z_n + μ‖z_t‖)/(1 + μ²).
+  const double s = (zn + b.mu * norm) / (1.0 + b.mu * b.mu);
+  l.piece = Piece::surface;
+  l.dir1 = z1 / norm;
+  l.dir2 = z2 / norm;
+  l.ratio = b.mu * s / norm;
+  f(n) = r(n) - s;
+  f(n + 1) = r(n + 1) - b.mu * s * l.dir1;
+  f(n + 2) = r(n + 2) - b.mu * s * l.dir2;
+}
+
+// F (the Alart–Curnier function, or the relaxation's natural map) at r with u = W r + q, and how each
+// block is linearized there.
 void evaluate(const std::vector<Block>& blocks, const Vector& r, const Vector& u, Vector& f,
               std::vector<Linearization>& lin) {
   lin.resize(blocks.size());
@@ -83,6 +132,10 @@ void evaluate(const std::vector<Block>& blocks, const Vector& r, const Vector& u
     if (b.role == RowRole::equality) {
       l.piece = Piece::active;
       f(n) = b.rho_n * u(n);
+      continue;
+    }
+    if (b.convex) {
+      evaluate_cone(b, r, u, f, l);
       continue;
     }
     const double zn = r(n) - b.rho_n * u(n);
@@ -127,6 +180,20 @@ void assemble_jacobian(const std::vector<Block>& blocks, const std::vector<Linea
     const Eigen::Index n = b.first;
     if (l.piece == Piece::open) {
       for (int j = 0; j < b.size; ++j) add(n + j, n + j, 1.0);
+      continue;
+    }
+    if (l.piece == Piece::surface) {
+      // dF = (I − J) dr + ρ J W dr, J = P_K's derivative on the surface (symmetric):
+      //   J_nn = 1/(1 + μ²), J_nt = μ ẑᵀ/(1 + μ²), J_tt = μ² ẑẑᵀ/(1 + μ²) + (μ s/‖z_t‖)(I − ẑẑᵀ).
+      const double dir[3] = {1.0, l.dir1, l.dir2}, scale = 1.0 / (1.0 + b.mu * b.mu);
+      for (int a = 0; a < 3; ++a)
+        for (int c = 0; c < 3; ++c) {
+          const double along = (a == 0 ? 1.0 : b.mu) * (c == 0 ? 1.0 : b.mu) * dir[a] * dir[c] * scale;
+          const double across = a > 0 && c > 0 ? l.ratio * ((a == c ? 1.0 : 0.0) - dir[a] * dir[c]) : 0.0;
+          const double j = along + across;
+          add(n + a, n + c, (a == c ? 1.0 : 0.0) - j);
+          add_w_row(n + a, n + c, b.rho_n * j);
+        }
       continue;
     }
     add_w_row(n, n, b.rho_n);
@@ -196,6 +263,14 @@ void gauss_seidel_sweep(const std::vector<Block>& blocks, const SparseMatrix& w,
       continue;
     }
     const double un = velocity(n), u1 = velocity(n + 1), u2 = velocity(n + 2);
+    if (b.convex) {  // a projected gradient step on the block: r ← P_K(r − ρ u), ρ = 1/λ_max
+      double zn = r(n) - b.rho_n * un, z1 = r(n + 1) - b.rho_n * u1, z2 = r(n + 2) - b.rho_n * u2;
+      project_on_cone(b.mu, zn, z1, z2);
+      r(n) = zn;
+      r(n + 1) = z1;
+      r(n + 2) = z2;
+      continue;
+    }
     r(n) = std::max(0.0, r(n) - b.rho_n * un);
     double t1 = r(n + 1) - b.rho_t * u1, t2 = r(n + 2) - b.rho_t * u2;
     const double radius = b.mu * r(n), norm = std::hypot(t1, t2);
@@ -249,8 +324,9 @@ double natural_map_residual(const FrictionalProblem& problem, const Vector& r) {
       ++i;
       continue;
     }
-    // y = r − (u + μ‖u_t‖ e_n) (De Saxcé's modified velocity), then r − P_K(y).
-    double yn = r(i) - u(i) - mu * std::hypot(u(i + 1), u(i + 2));
+    // y = r − (u + μ‖u_t‖ e_n) (De Saxcé's modified velocity; the relaxation has no shift), then r − P_K(y).
+    const double shift = problem.convex ? 0.0 : mu * std::hypot(u(i + 1), u(i + 2));
+    double yn = r(i) - u(i) - shift;
     double y1 = r(i + 1) - u(i + 1), y2 = r(i + 2) - u(i + 2);
     project_on_cone(mu, yn, y1, y2);
     const double en = r(i) - yn, e1 = r(i + 1) - y1, e2 = r(i + 2) - y2;
@@ -350,20 +426,96 @@ Vector FrictionalSolver::proximal_newton(const FrictionalProblem& problem, const
 }
 
 Vector FrictionalSolver::solve(const FrictionalProblem& problem, FrictionalStats& stats) {
-  const SparseMatrix& w = *problem.w;
   const Eigen::Index m = problem.q.size();
+  ++stats.problems;
+  const Vector* start = problem.start != nullptr && problem.start->size() == m && problem.start->allFinite()
+                            ? problem.start
+                            : nullptr;
+  Vector r = start != nullptr ? *start : Vector::Zero(m);
+  double residual = 0.0;
+  if (problem.convex || start != nullptr) {
+    residual = solve_stages(problem, r, start != nullptr, stats);
+  } else {
+    // 1. The convex relaxation: among Coulomb's solutions of a redundant problem it picks the one a
+    //    static equilibrium gives, whenever one exists (velocities 0 where the relaxation's are, see
+    //    the header), and its answer is Coulomb's wherever no pressed contact slips.
+    FrictionalProblem relaxed = problem;
+    relaxed.convex = true;
+    relaxed.start = nullptr;
+    ++stats.relaxed;
+    const double relaxed_residual = solve_stages(relaxed, r, false, stats);
+    residual = natural_map_residual(problem, r);
+    // 2. Where a pressed contact slips, the relaxation separates it at μ‖u_t‖ instead. Cadoux's fixed
+    //    point removes that: the relaxation again with q_n raised by s = μ‖u_t‖ of the last answer (a
+    //    fixed point is a Coulomb solution), each answer tried as a start for Newton on Coulomb's problem
+    //    itself, which converges fast near a solution.
+    const std::vector<Block> blocks = make_blocks(problem, problem.w->diagonal());
+    Vector best = r;
+    double best_residual = residual;
+    for (std::uint64_t k = 0; k < settings_.fixed_point_iterations && best_residual > problem.tolerance &&
+                              relaxed_residual <= relaxed.tolerance;
+         ++k) {
+      ++stats.fixed_point_steps;
+      steps_left_ = settings_.polish_newton_iterations;
+      Vector polished = r;
+      if (const double now = newton(problem, blocks, polished, settings_.polish_newton_iterations, stats);
+          now < best_residual) {
+        best_residual = now;
+        best = polished;
+      }
+      if (best_residual <= problem.tolerance) break;
+      const Vector u = *problem.w * r + problem.q;
+      relaxed.q = problem.q;
+      for (const Block& block : blocks)
+        if (block.size == 3) relaxed.q(block.first) += block.mu * std::hypot(u(block.first + 1), u(block.first + 2));
+      if (solve_stages(relaxed, r, false, stats) > relaxed.tolerance) break;
+      if (const double now = natural_map_residual(problem, r); now < best_residual) {
+        best_residual = now;
+        best = r;
+      }
+    }
+    r = best;
+    residual = best_residual;
+    // 3. Still not solved: the stages on Coulomb's problem from the best answer.
+    if (residual > problem.tolerance) residual = solve_stages(problem, r, true, stats);
+    // 4. A slipping answer: a few more Newton steps. Near a solution they converge quadratically, so
+    //    the answer is exact to rounding, not just to the tolerance, and does not depend on which stage
+    //    found it (a slope turned about its normal gives the same slip to 1e-12).
+    if (residual <= problem.tolerance && residual > 0.0) {
+      FrictionalProblem exact = problem;
+      exact.tolerance = 0.0;
+      steps_left_ = settings_.refinement_steps;
+      residual = newton(exact, blocks, r, settings_.refinement_steps, stats);
+    }
+  }
+  if (residual > problem.tolerance) ++stats.non_converged;
+  stats.residual = std::max(stats.residual, residual);
+  return r;
+}
+
+// The stages (file comment) on `problem` from r, which they overwrite with the best iterate met; returns
+// its natural-map residual.
+double FrictionalSolver::solve_stages(const FrictionalProblem& problem, Vector& r, bool warm, FrictionalStats& stats) {
+  const SparseMatrix& w = *problem.w;
   const Vector diagonal = w.diagonal();
   const std::vector<Block> blocks = make_blocks(problem, diagonal);
-  ++stats.problems;
   steps_left_ = settings_.max_newton_steps;
 
-  // 1. Newton on the problem itself, from r = 0: enough whenever W is well conditioned on the contacts
-  //    that end up pressed.
-  Vector r = problem.start != nullptr && problem.start->size() == m && problem.start->allFinite() ? *problem.start
-                                                                                                 : Vector::Zero(m);
+  // 1. Newton on the problem itself: enough whenever W is well conditioned on the contacts that end up
+  //    pressed, or near a solution.
   double residual = natural_map_residual(problem, r);
-  if (!likely_redundant(problem) || problem.start != nullptr)
-    residual = newton(problem, blocks, r, settings_.newton_iterations, stats);
+  bool polish = false;  // Newton only polishes the interior-point answer
+  if (problem.convex && !warm) {
+    // The relaxation is a convex cone program: an interior-point method solves it whatever the
+    // redundancy, and Newton polishes its answer.
+    ConeQpReport report;
+    r = solve_cone_qp(problem, problem.tolerance, settings_.interior_point_iterations, report);
+    stats.interior_point_steps += report.iterations;
+    residual = natural_map_residual(problem, r);
+    warm = polish = true;
+  }
+  if (!likely_redundant(problem) || warm)
+    residual = newton(problem, blocks, r, polish ? settings_.polish_newton_iterations : settings_.newton_iterations, stats);
 
   // 2. Redundant contacts or a stalled Newton: proximal Newton steps (fast near a solution, and
   //    bounded along W's null space), and if they stall, a round of projected Gauss–Seidel sweeps
@@ -390,10 +542,7 @@ Vector FrictionalSolver::solve(const FrictionalProblem& problem, FrictionalStats
     }
   }
   r = best;
-  residual = best_residual;
-  if (residual > problem.tolerance) ++stats.non_converged;
-  stats.residual = std::max(stats.residual, residual);
-  return r;
+  return best_residual;
 }
 
 }  // namespace impetus::ledas

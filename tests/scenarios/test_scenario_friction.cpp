@@ -292,6 +292,36 @@ TEST(ScenarioFriction, CardHouseCollapsesWithTooLittleFriction) {
   }
 }
 
+// Three spheres (friction_pyramid_10.yaml with K = 2): the top one on two touching lower ones. By statics
+// (the lower spheres' torque balance makes their ground friction equal the friction at the upper
+// contacts, and the mirror symmetry the friction between them zero) the pyramid can stand iff
+// μ ≥ 2 − √3 ≈ 0.2679 = tan 15°. At μ = 0.27 it stands exactly (no sphere moves by 1e-9 m in 2 s at
+// 60 Hz), at μ = 0.26 the top sphere wedges the others apart and drops by more than 1 cm within 1 s.
+TEST(ScenarioFriction, ThreeSpheresStandIffFrictionReachesTanFifteenDegrees) {
+  IMPETUS_REQUIRE_PLUGINS({"detector", "fcl"}, {"resolver", "ledas"});
+  const auto pyramid = [](double mu) {
+    return std::vector<SceneOverride>{{"generators.0.pyramid.rows", "2"}, {"generators.0.pyramid.friction", number(mu)}};
+  };
+  SceneRun above("friction_pyramid_10.yaml", pyramid(0.27));
+  const Standing s = stand(above, 120);
+  EXPECT_LT(s.drift, 1e-9);
+  SceneRun below("friction_pyramid_10.yaml", pyramid(0.26));
+  const double top = below.body("pyramid_r1_0").position.z();
+  step(below, 60);
+  EXPECT_LT(below.body("pyramid_r1_0").position.z(), top - 0.01);
+}
+
+// The resting pyramid K = 10 (55 spheres, 145 contacts) with μ = 0.7: a static equilibrium exists, the
+// convex relaxation finds it, and the pyramid stands exactly — no sphere moves by 1e-9 m in 2 s (the
+// scene's 10 s run: 3e-12 m). With μ = 0.5 none exists (resolution/ledas/README.md, "Friction").
+TEST(ScenarioFriction, PyramidOfTenStandsWhereAnEquilibriumExists) {
+  IMPETUS_REQUIRE_PLUGINS({"detector", "fcl"}, {"resolver", "ledas"});
+  SceneRun run("friction_pyramid_10.yaml");
+  const Standing s = stand(run, 120);
+  EXPECT_LT(s.drift, 1e-9);
+  EXPECT_LT(s.penetration, 1e-3);
+}
+
 // A scene with friction and a resolver that does not model it is an error naming friction (ledas's
 // paper mode has no friction formulas); it is never silently ignored.
 TEST(ScenarioFriction, ResolverWithoutFrictionIsRefused) {

@@ -188,3 +188,37 @@ TEST(LedasFriction, FrictionalSolverDoesNotDependOnTheTangentBasis) {
 
 }  // namespace
 }  // namespace impetus
+
+namespace impetus {
+namespace {
+
+// The convex relaxation against its closed form on one contact with W = I, q = (−1, 2, 0), μ = 0.5: r is
+// the projection of −q on the cone, s = (1 + μ·2)/(1 + μ²) = 1.6, r = (1.6, −0.8, 0), and the contact
+// separates at u_n = μ‖u_t‖ = 0.6. Coulomb's problem on the same contact slides without separating:
+// u_n = 0, r = (1, −0.5, 0). Both to 1e-12.
+TEST(LedasFriction, RelaxationAndCoulombMatchTheirClosedFormsOnOneContact) {
+  const ledas::SparseMatrix w = Eigen::MatrixXd::Identity(3, 3).sparseView();
+  ledas::FrictionalProblem problem;
+  problem.w = &w;
+  problem.q = ledas::Vector::Zero(3);
+  problem.q << -1.0, 2.0, 0.0;
+  problem.role = {ledas::RowRole::normal, ledas::RowRole::tangent, ledas::RowRole::tangent};
+  problem.mu = {0.5, 0.0, 0.0};
+  problem.tolerance = 1e-13;
+  ledas::FrictionalSolver solver;
+  ledas::FrictionalStats stats;
+  const ledas::Vector coulomb = solver.solve(problem, stats);
+  problem.convex = true;
+  const ledas::Vector relaxed = solver.solve(problem, stats);
+  EXPECT_EQ(stats.non_converged, 0u);
+  EXPECT_NEAR(relaxed(0), 1.6, 1e-12);
+  EXPECT_NEAR(relaxed(1), -0.8, 1e-12);
+  EXPECT_NEAR(relaxed(2), 0.0, 1e-12);
+  EXPECT_NEAR((w * relaxed + problem.q)(0), 0.6, 1e-12);
+  EXPECT_NEAR(coulomb(0), 1.0, 1e-12);
+  EXPECT_NEAR(coulomb(1), -0.5, 1e-12);
+  EXPECT_NEAR(coulomb(2), 0.0, 1e-12);
+}
+
+}  // namespace
+}  // namespace impetus

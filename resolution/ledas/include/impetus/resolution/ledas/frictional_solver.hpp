@@ -54,6 +54,10 @@ struct FrictionalProblem {
   /// Optional first iterate (size m), e.g. the all-stick impulses W r = −q: of several solutions (Coulomb
   /// friction's are not unique with redundant contacts), Newton finds one near its start.
   const Vector* start = nullptr;
+  /// Solve the convex relaxation instead (Anitescu's cone complementarity: r ∈ K, u ∈ K*, rᵀu = 0, with
+  /// K* = {u_n ≥ μ‖u_t‖}; a slipping contact separates at μ‖u_t‖). Its velocities are unique, and a
+  /// static equilibrium (u = 0 with r in the cones), when one exists, is its answer.
+  bool convex = false;
 };
 
 /// How frictional problems are solved (configuration).
@@ -63,6 +67,10 @@ struct FrictionalSettings {
   /// Newton steps per problem at most, over all stages: bounds the work of a problem the method cannot
   /// solve (then the best iterate is returned and counted in non_converged).
   std::uint64_t max_newton_steps = 300;
+  std::uint64_t interior_point_iterations = 60;  ///< interior-point steps on the convex relaxation at most
+  std::uint64_t fixed_point_iterations = 1;     ///< Cadoux's fixed-point steps (relaxations) at most
+  std::uint64_t polish_newton_iterations = 8;   ///< Newton steps on Coulomb's problem from each of them
+  std::uint64_t refinement_steps = 3;           ///< Newton steps past the tolerance on a slipping answer
   std::uint64_t hybrid_rounds = 40;      ///< rounds of proximal Newton then Gauss–Seidel sweeps, at most
   std::uint64_t sweeps_per_round = 20;   ///< projected Gauss–Seidel sweeps per round
   double regularization = 1e-10;         ///< W's diagonal shift in the Jacobian, × max W_ii
@@ -76,7 +84,10 @@ struct FrictionalSettings {
 /// What the solver did, accumulated over calls (reset by the caller).
 struct FrictionalStats {
   std::uint64_t problems = 0;          ///< problems solved
+  std::uint64_t relaxed = 0;           ///< Coulomb problems started from their convex relaxation
+  std::uint64_t fixed_point_steps = 0; ///< Cadoux's fixed-point steps
   std::uint64_t newton_steps = 0;      ///< Newton steps (one factorization each)
+  std::uint64_t interior_point_steps = 0;  ///< interior-point steps on relaxations (one factorization each)
   std::uint64_t proximal = 0;          ///< problems that needed the proximal stage (redundant contacts)
   std::uint64_t proximal_steps = 0;    ///< its proximal points (a Newton solve each)
   std::uint64_t fallbacks = 0;         ///< problems where the projected Gauss–Seidel fallback ran
@@ -108,6 +119,7 @@ class FrictionalSolver {
   struct Block;  // one contact's rows (frictional_solver.cpp)
 
  private:
+  double solve_stages(const FrictionalProblem& problem, Vector& r, bool warm, FrictionalStats& stats);
   double newton(const FrictionalProblem& problem, const std::vector<Block>& blocks, Vector& r,
                 std::uint64_t iterations, FrictionalStats& stats);
   Vector proximal_newton(const FrictionalProblem& problem, const std::vector<Block>& blocks, Vector r,
