@@ -20,9 +20,31 @@ constexpr std::uint64_t kJointRounds = 16;
 
 using ledas::Vector;
 
-// Solves the island's frictional problem u = A r + q (A = W over the island's rows, q = v − target).
-Vector LedasResolver::solve_frictional(ledas::Island& island, const Vector& q) {
+// The last step's impulses of the island's rows (0 where a contact is new).
+Vector LedasResolver::warm_start(const ledas::Island& island) const {
+  Vector r(static_cast<Eigen::Index>(island.rows.size()));
+  for (std::size_t i = 0; i < island.rows.size(); ++i) r(static_cast<Eigen::Index>(i)) = row_warm_[island.rows[i]];
+  return r;
+}
+
+// Keeps the island's frictional contacts' inelastic impulses for the next step's warm start.
+void LedasResolver::remember_impulses(const ledas::Island& island, std::span<const Contact> contacts) {
+  for (std::size_t i = 0; i < island.rows.size(); ++i) {
+    if (!island.normal_row(i) || !(island.mu[i] > 0.0)) continue;
+    const auto ei = static_cast<Eigen::Index>(i);
+    const Contact& c = contacts[static_cast<std::size_t>(info_[island.rows[i]].contact)];
+    ContactImpulse& p = next_warm_[ContactKey{c.a, c.b, c.feature}];
+    p.normal = island.impulse_inelastic(ei);
+    p.tangent = island.impulse_inelastic(ei + 1) * rows_[island.rows[i + 1]].normal +
+                island.impulse_inelastic(ei + 2) * rows_[island.rows[i + 2]].normal;
+  }
+}
+
+// Solves the island's frictional problem u = A r + q (A = W over the island's rows, q = v − target),
+// tried first from `start` if given.
+Vector LedasResolver::solve_frictional(ledas::Island& island, const Vector& q, const Vector* start) {
   ledas::FrictionalProblem problem;
+  problem.start = start;
   problem.w = &island.a;
   problem.q = q;
   problem.role = island.role;
@@ -77,7 +99,8 @@ void LedasResolver::velocity_frictional(ledas::Island& island, std::span<RigidBo
     if (round > 0 && !refine) break;
     if (round == 0 && !needed && !refine) return;
     const std::uint64_t failures = stats_.friction.non_converged;
-    Vector r = solve_frictional(island, v - island.target);
+    const Vector warm = round == 0 && settings_.warm_start ? warm_start(island) : Vector();
+    Vector r = solve_frictional(island, v - island.target, warm.size() > 0 && warm.any() ? &warm : nullptr);
     // A problem left unsolved (counted) still must not create energy: its best iterate is scaled back
     // so that ΔE = rᵀv + ½ rᵀA r ≤ 0 (rows' velocities v before it).
     if (stats_.friction.non_converged != failures) {

@@ -428,13 +428,29 @@ Vector FrictionalSolver::proximal_newton(const FrictionalProblem& problem, const
 Vector FrictionalSolver::solve(const FrictionalProblem& problem, FrictionalStats& stats) {
   const Eigen::Index m = problem.q.size();
   ++stats.problems;
-  const Vector* start = problem.start != nullptr && problem.start->size() == m && problem.start->allFinite()
-                            ? problem.start
-                            : nullptr;
-  Vector r = start != nullptr ? *start : Vector::Zero(m);
+  const bool warm = problem.start != nullptr && problem.start->size() == m && problem.start->allFinite();
+  Vector r = Vector::Zero(m);
   double residual = 0.0;
-  if (problem.convex || start != nullptr) {
-    residual = solve_stages(problem, r, start != nullptr, stats);
+  if (warm && !problem.convex) {
+    // 0. The warm start (e.g. the last step's impulses): a resting body's usually solve the problem as
+    //    they are; otherwise a few Newton steps from them, and if those do not reach the tolerance, the
+    //    cold path below.
+    r = *problem.start;
+    residual = natural_map_residual(problem, r);
+    if (residual > problem.tolerance) {
+      steps_left_ = settings_.polish_newton_iterations;
+      residual = newton(problem, make_blocks(problem, problem.w->diagonal()), r, settings_.polish_newton_iterations, stats);
+    }
+    if (residual <= problem.tolerance) {
+      ++stats.warm_started;
+      stats.residual = std::max(stats.residual, residual);
+      return r;
+    }
+    r.setZero();
+  }
+  if (problem.convex) {
+    if (warm) r = *problem.start;
+    residual = solve_stages(problem, r, warm, stats);
   } else {
     // 1. The convex relaxation: among Coulomb's solutions of a redundant problem it picks the one a
     //    static equilibrium gives, whenever one exists (velocities 0 where the relaxation's are, see

@@ -43,6 +43,7 @@ LedasSettings LedasSettings::from_options(const ModuleOptions& options) {
   s.solver.sharpen_refinement = options.boolean("sharpen_refinement", s.solver.sharpen_refinement);
   s.solver.max_iterations = s.max_rounds;
   s.islands = options.boolean("islands", s.islands);
+  s.warm_start = options.boolean("warm_start", s.warm_start);
   s.resting = resolution::RestingSettings::from_options(options);
   return s;
 }
@@ -89,7 +90,7 @@ void LedasResolver::resolve(std::span<RigidBody> bodies, std::span<Contact> cont
   // A velocity problem without a solution (conflicting joint targets) fails the step's promise; a
   // position correction without one (a body squeezed between fixed bodies) is corrected as far as it
   // can be, and shows only in last_stats().position.infeasible.
-  counters.rounds += stats_.friction.newton_steps + stats_.friction.fallback_sweeps;
+  counters.rounds += stats_.friction.newton_steps + stats_.friction.interior_point_steps + stats_.friction.fallback_sweeps;
   counters.non_converged += stats_.velocity.non_converged + stats_.velocity.infeasible + stats_.position.non_converged +
                             stats_.friction.non_converged;
   counters.natural_map_residual = std::max(counters.natural_map_residual, stats_.friction.residual);
@@ -100,6 +101,8 @@ void LedasResolver::resolve(std::span<RigidBody> bodies, std::span<Contact> cont
 void LedasResolver::resolve_all(std::span<RigidBody> bodies, std::span<Contact> contacts,
                                 std::span<const Constraint> constraints, const StepContext& ctx,
                                 ResolverCounters& counters) {
+  warm_.swap(next_warm_);
+  next_warm_.clear();
   build_rows(bodies, contacts, constraints, ctx.dt, counters);
   std::vector<std::vector<std::uint32_t>> islands = resolution::find_islands(rows_, bodies.size(), bodies);
   body_slot_.assign(bodies.size(), -1);
@@ -118,6 +121,7 @@ void LedasResolver::build_rows(std::span<const RigidBody> bodies, std::span<Cont
                                std::span<const Constraint> constraints, double dt, ResolverCounters& counters) {
   rows_.clear();
   info_.clear();
+  row_warm_.clear();
   inertia_.reset(bodies.size());
   for (std::size_t k = 0; k < contacts.size(); ++k) {
     Contact& c = contacts[k];
@@ -129,6 +133,9 @@ void LedasResolver::build_rows(std::span<const RigidBody> bodies, std::span<Cont
       continue;
     }
     rows_.push_back(resolution::make_contact_row(bodies, inertia_, c));
+    const auto warm = warm_.find(ContactKey{c.a, c.b, c.feature});
+    const bool warmed = warm != warm_.end() && settings_.warm_start;
+    row_warm_.push_back(warmed ? warm->second.normal : 0.0);
     ledas::RowInfo ri;
     ri.depth = c.depth;
     ri.contact = static_cast<std::int64_t>(k);
@@ -139,12 +146,14 @@ void LedasResolver::build_rows(std::span<const RigidBody> bodies, std::span<Cont
       tangent_basis(c.normal, t[0], t[1]);
       for (std::uint8_t j = 0; j < 2; ++j) {
         rows_.push_back(resolution::make_row(bodies, inertia_, c.a, c.b, c.point, t[j]));
+        row_warm_.push_back(warmed ? warm->second.tangent.dot(t[j]) : 0.0);
         ri.tangent = static_cast<std::uint8_t>(j + 1);
         info_.push_back(ri);
       }
     }
   }
   for (const Constraint& c : constraints) ledas::append_constraint_rows(bodies, inertia_, c, dt, rows_, info_);
+  row_warm_.resize(rows_.size(), 0.0);
 }
 
 // One island: the velocity phase by mode, its report, then the position correction.
@@ -160,6 +169,7 @@ void LedasResolver::solve_island(std::vector<std::uint32_t> rows, std::span<Rigi
   if (island.bouncing() && energy_after > energy_before * (1.0 + ledas::kRoundoff) + 1e-300)
     ++counters.energy_gain_events;
   report_island(island, bodies, contacts, counters);
+  if (island.frictional && settings_.warm_start) remember_impulses(island, contacts);
   correct_positions(island, bodies);
   ++counters.islands;
   ++stats_.islands;

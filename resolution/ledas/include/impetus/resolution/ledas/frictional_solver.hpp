@@ -11,8 +11,14 @@
 /// the frictionless solver's; a joint row is an equality u = 0 with r free. Knows nothing of bodies:
 /// W and q come in, r comes out, so it is tested (and later fed fclib's problems) directly.
 ///
-/// Method (resolution/ledas/README.md, "Friction"): a semismooth Newton method on the Alart–Curnier
-/// function
+/// Method (resolution/ledas/README.md, "Friction"), in stages:
+///  0. a warm start, if given: taken if it solves the problem, else polished by a few Newton steps;
+///  1. the convex relaxation (`convex`), solved by an interior-point method (cone_qp.hpp) and polished by
+///     Newton on its natural map: a static equilibrium is its answer whenever one exists, and where its
+///     answer has no pressed contact slipping it is Coulomb's answer;
+///  2. else Newton on Coulomb's problem from it, one step of Cadoux's fixed point (the relaxation with q_n
+///     raised by μ‖u_t‖), and the stages below; a slipping answer gets a few Newton steps past the
+///     tolerance. The Newton stages: a semismooth Newton method on the Alart–Curnier function
 ///   F_n = r_n − max(0, z_n),  z_n = r_n − ρ_n u_n,
 ///   F_t = r_t − P_D(μ max(0, z_n)) (z_t),  z_t = r_t − ρ_t u_t,  P_D(R) the projection on the disk ‖·‖ ≤ R,
 /// whose zeros are exactly the solutions above (ρ > 0 per contact; the cone is round and ρ_t is one
@@ -51,8 +57,8 @@ struct FrictionalProblem {
   /// Degrees of freedom behind W (6 per movable body), 0 if unknown. More rows than that: W is singular,
   /// and the solver starts with its proximal stage.
   std::size_t dofs = 0;
-  /// Optional first iterate (size m), e.g. the all-stick impulses W r = −q: of several solutions (Coulomb
-  /// friction's are not unique with redundant contacts), Newton finds one near its start.
+  /// Optional warm start (size m), e.g. the last step's impulses: taken if it solves the problem, else
+  /// polished by a few Newton steps; if those fail, the solve starts cold (from the convex relaxation).
   const Vector* start = nullptr;
   /// Solve the convex relaxation instead (Anitescu's cone complementarity: r ∈ K, u ∈ K*, rᵀu = 0, with
   /// K* = {u_n ≥ μ‖u_t‖}; a slipping contact separates at μ‖u_t‖). Its velocities are unique, and a
@@ -84,6 +90,7 @@ struct FrictionalSettings {
 /// What the solver did, accumulated over calls (reset by the caller).
 struct FrictionalStats {
   std::uint64_t problems = 0;          ///< problems solved
+  std::uint64_t warm_started = 0;      ///< problems solved from their warm start (`start`)
   std::uint64_t relaxed = 0;           ///< Coulomb problems started from their convex relaxation
   std::uint64_t fixed_point_steps = 0; ///< Cadoux's fixed-point steps
   std::uint64_t newton_steps = 0;      ///< Newton steps (one factorization each)

@@ -18,7 +18,9 @@
 #include "impetus/resolution/ledas/frictional_solver.hpp"
 #include "impetus/resolution/ledas/island_solver.hpp"
 
+#include <compare>
 #include <cstdint>
+#include <map>
 #include <vector>
 
 namespace impetus {
@@ -69,6 +71,10 @@ struct LedasSettings {
   /// one system (`islands: false`: the same velocities up to rounding, with the bounce threshold judged
   /// over all rows; only slower or faster, as benchmarks/model.cpp measures).
   bool islands = true;
+  /// Frictional islands start from the last step's impulses of the contacts they still have (matched by
+  /// bodies and the detector's feature key): a resting body's impulses usually solve the next step's
+  /// problem as they are (`warm_start: false` starts every step from its convex relaxation).
+  bool warm_start = true;
   /// Options `slop`, `correction`, `bounce_threshold` (impetus/resolution/common/resting.hpp).
   resolution::RestingSettings resting;
 
@@ -154,7 +160,9 @@ class LedasResolver final : public CollisionResolver {
   void velocity_paper(ledas::Island& island, std::span<RigidBody> bodies, ResolverCounters& counters);
   void velocity_complementary(ledas::Island& island, std::span<RigidBody> bodies, ResolverCounters& counters);
   void velocity_frictional(ledas::Island& island, std::span<RigidBody> bodies, ResolverCounters& counters);
-  ledas::Vector solve_frictional(ledas::Island& island, const ledas::Vector& q);
+  ledas::Vector solve_frictional(ledas::Island& island, const ledas::Vector& q, const ledas::Vector* start = nullptr);
+  ledas::Vector warm_start(const ledas::Island& island) const;
+  void remember_impulses(const ledas::Island& island, std::span<const Contact> contacts);
   void apply_island_impulse(ledas::Island& island, const ledas::Vector& p, std::span<RigidBody> bodies,
                             ResolverCounters& counters);
   void narrow_start_set(const ledas::Island& island, const ledas::Vector& v, std::vector<char>& start);
@@ -173,6 +181,20 @@ class LedasResolver final : public CollisionResolver {
   resolution::InverseInertiaCache inertia_;  // the bodies' J⁻¹ while this step's rows are built
   std::vector<std::int32_t> body_slot_;  // per body: its slot in the current island's movable bodies, or −1
   std::vector<std::int32_t> hops_, queue_;  // narrow_start_set's distances and search queue (reused)
+  // Warm starts: a frictional contact's inelastic impulse (normal; tangential as a world vector) by its
+  // bodies and feature key, from the last step (`warm_`) and for the next (`next_warm_`); per row of
+  // this step, the warm start found for it (0 if none).
+  struct ContactKey {
+    BodyIndex a = 0, b = 0;
+    std::uint64_t feature = 0;
+    auto operator<=>(const ContactKey&) const = default;
+  };
+  struct ContactImpulse {
+    double normal = 0.0;
+    Vec3 tangent = Vec3::Zero();
+  };
+  std::map<ContactKey, ContactImpulse> warm_, next_warm_;
+  std::vector<double> row_warm_;
 };
 
 }  // namespace impetus
