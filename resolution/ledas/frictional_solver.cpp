@@ -437,9 +437,9 @@ Vector FrictionalSolver::solve(const FrictionalProblem& problem, FrictionalStats
     //    cold path below.
     r = *problem.start;
     residual = natural_map_residual(problem, r);
-    if (residual > problem.tolerance) {
-      steps_left_ = settings_.polish_newton_iterations;
-      residual = newton(problem, make_blocks(problem, problem.w->diagonal()), r, settings_.polish_newton_iterations, stats);
+    if (residual > problem.tolerance && settings_.warm_newton_iterations > 0) {
+      steps_left_ = settings_.warm_newton_iterations;
+      residual = newton(problem, make_blocks(problem, problem.w->diagonal()), r, settings_.warm_newton_iterations, stats);
     }
     if (residual <= problem.tolerance) {
       ++stats.warm_started;
@@ -461,10 +461,12 @@ Vector FrictionalSolver::solve(const FrictionalProblem& problem, FrictionalStats
     ++stats.relaxed;
     const double relaxed_residual = solve_stages(relaxed, r, false, stats);
     residual = natural_map_residual(problem, r);
-    // 2. Where a pressed contact slips, the relaxation separates it at μ‖u_t‖ instead. Cadoux's fixed
-    //    point removes that: the relaxation again with q_n raised by s = μ‖u_t‖ of the last answer (a
-    //    fixed point is a Coulomb solution), each answer tried as a start for Newton on Coulomb's problem
-    //    itself, which converges fast near a solution.
+    const bool relaxation_solves = residual <= problem.tolerance;
+    // 2. Where a pressed contact slips, the relaxation separates it at μ‖u_t‖ instead. Newton on
+    //    Coulomb's problem from its answer (fast near a solution), then Cadoux's fixed point: the
+    //    relaxation again with q_n raised by s = μ‖u_t‖ of the last answer (a fixed point is a Coulomb
+    //    solution), each answer again a start for Newton. On the collapsing sphere pyramid further
+    //    fixed-point steps oscillated (damped too), so by default one is taken.
     const std::vector<Block> blocks = make_blocks(problem, problem.w->diagonal());
     Vector best = r;
     double best_residual = residual;
@@ -497,7 +499,7 @@ Vector FrictionalSolver::solve(const FrictionalProblem& problem, FrictionalStats
     // 4. A slipping answer: a few more Newton steps. Near a solution they converge quadratically, so
     //    the answer is exact to rounding, not just to the tolerance, and does not depend on which stage
     //    found it (a slope turned about its normal gives the same slip to 1e-12).
-    if (residual <= problem.tolerance && residual > 0.0) {
+    if (!relaxation_solves && residual <= problem.tolerance && residual > 0.0) {
       FrictionalProblem exact = problem;
       exact.tolerance = 0.0;
       steps_left_ = settings_.refinement_steps;

@@ -173,7 +173,7 @@ Standing stand(SceneRun& run, int steps) {
 // angle atan 0.5 ≈ 26.6° and below the angle atan(0.5 / 5) ≈ 5.7° at which the whole stack would tip
 // over its lower edge), at the scene's 60 Hz. The minute-long runs are the commands in the scene's
 // header: `impetus run assets/scenes/friction_stack_10.yaml --duration 60` moves no box by more than
-// 4e-11 m, and the same with `--set "gravity=[0.6843,0,-9.786]"` (4°) by 7.5e-12 m (about 2 s and 6 s of
+// 4e-11 m, and the same with `--set "gravity=[0.6843,0,-9.786]"` (4°) by 2.4e-9 m (about 2.5 s of
 // wall time, which is why the tests run 10 s and 5 s).
 void expect_stack_stands(double degrees, int steps) {
   IMPETUS_REQUIRE_PLUGINS({"detector", "fcl"}, {"resolver", "ledas"});
