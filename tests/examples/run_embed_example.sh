@@ -19,6 +19,8 @@ mass=$("$work/prefix/bin/impetus" mass "$work/prefix/share/impetus/meshes/cube.o
 if [[ -n "$template" ]]; then
   cmake -S "$template" -B "$work/template" -G Ninja -DCMAKE_PREFIX_PATH="$work/prefix" >/dev/null
   cmake --build "$work/template" >/dev/null
+  grep -q '^CMAKE_BUILD_TYPE:STRING=Release$' "$work/template/CMakeCache.txt" || {
+    echo "the plugin template does not default to an optimised (Release) build" >&2; exit 1; }
   ctest --test-dir "$work/template" --output-on-failure >/dev/null || {
     echo "the plugin template fails the installed conformance suite" >&2
     ctest --test-dir "$work/template" --output-on-failure >&2; exit 1; }
