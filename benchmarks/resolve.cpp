@@ -14,8 +14,16 @@
 //                           e = 1: residual ≤ 1e-9 m/s and |energy_change| ≤ 1e-9
 //   cold_ms                 wall time of the untimed first call (ms): with what is set up once per
 //                           contact graph (ledas: symbolic analyses), which the timed iterations reuse
+// With friction (scenes "…_muX": every contact's μ = X), also:
+//   natural_map             fclib's natural-map residual of the impulses applied (Contact::impulse,
+//                           tangent_impulse) on the scene's contact problem (core/fclib), unscaled; the
+//                           same measure for every resolver
+//   sticking, sliding       contacts the resolver reports sticking and sliding
+//   exact                   natural_map ≤ 1e-9 and no approach left (≤ 1e-9 m/s)
 #include "support/bench_resolvers.hpp"
 #include "support/bench_scenes.hpp"
+
+#include "impetus/fclib/fclib.hpp"
 
 #include <benchmark/benchmark.h>
 
@@ -72,6 +80,21 @@ void resolve(benchmark::State& state, const std::string& resolver_name, const st
   state.counters["energy_change"] = q.energy_change;
   state.counters["exact"] = exact ? 1.0 : 0.0;
   state.counters["cold_ms"] = cold_ms;
+  if (bench::key_friction(scene_key) > 0.0) {
+    const fclib::SceneProblem problem = fclib::scene_problem(prepared.bodies, prepared.contacts, ctx.dt);
+    fclib::Vector r(static_cast<Eigen::Index>(problem.local.rows()));
+    for (std::size_t k = 0; k < problem.contacts.size(); ++k) {
+      const Contact& c = contacts[problem.contacts[k]];
+      Vec3 t1, t2;
+      tangent_basis(c.normal, t1, t2);
+      r.segment<3>(static_cast<Eigen::Index>(3 * k)) = Vec3(c.impulse, c.tangent_impulse.dot(t1), c.tangent_impulse.dot(t2));
+    }
+    const double natural_map = fclib::natural_map_residual(problem.local, r);
+    state.counters["natural_map"] = natural_map;
+    state.counters["sticking"] = static_cast<double>(counters.sticking);
+    state.counters["sliding"] = static_cast<double>(counters.sliding);
+    state.counters["exact"] = natural_map <= 1e-9 && q.approach <= 1e-9 ? 1.0 : 0.0;
+  }
 }
 
 /// Rows left out: the paper mode on pyramid K = 100 (tens of thousands of rounds on 15 000 contacts) and
@@ -91,9 +114,17 @@ int register_all() {
     scenes.emplace_back("line_" + std::to_string(n) + "_e0", n);
     scenes.emplace_back("line_" + std::to_string(n) + "_e1", n);
   }
+  // With friction (the paper mode refuses friction): the dropped pyramid where every contact can stick
+  // (μ = 0.7) and where supports slide (0.5, 0.2; K ≤ 20: beyond, ledas's Coulomb stage takes minutes),
+  // and the line, where nothing slips.
+  for (int k : {3, 10, 20, 50, 100}) scenes.emplace_back("pyramid_" + std::to_string(k) + "_mu0.7", k * (k + 1) / 2);
+  for (const char* mu : {"0.5", "0.2"})
+    for (int k : {3, 10, 20}) scenes.emplace_back("pyramid_" + std::to_string(k) + "_mu" + mu, k * (k + 1) / 2);
+  for (int n : {10, 100, 1000, 10000}) scenes.emplace_back("line_" + std::to_string(n) + "_e0_mu0.5", n);
   for (const std::string resolver : {"ledas", "ledas_paper", "mirtich"}) {
     for (const auto& [key, bodies] : scenes) {
       if (bodies > max_bodies || too_slow(resolver, key)) continue;
+      if (resolver == "ledas_paper" && bench::key_friction(key) > 0.0) continue;
       benchmark::RegisterBenchmark(("resolve/" + resolver + "/" + key).c_str(),
                                    [resolver, key](benchmark::State& st) { resolve(st, resolver, key); })
           ->Unit(benchmark::kMillisecond);

@@ -63,7 +63,14 @@ inline PreparedScene line_push(int count, double restitution) {
   return prepare("line_" + std::to_string(count) + (restitution > 0 ? "_e1" : "_e0"), make_line(p));
 }
 
-/// The scene named "pyramid_K", "line_N_e0" or "line_N_e1", prepared once per process.
+/// The friction coefficient a scene key ends with ("pyramid_20_mu0.5" → 0.5), or 0.
+inline double key_friction(const std::string& key) {
+  const auto at = key.rfind("_mu");
+  return at == std::string::npos ? 0.0 : std::stod(key.substr(at + 3));
+}
+
+/// The scene named "pyramid_K", "line_N_e0" or "line_N_e1", with "_muX" after it every body's friction X
+/// (so every contact's μ is X), prepared once per process.
 inline const PreparedScene& prepared_scene(const std::string& key) {
   static std::map<std::string, PreparedScene> cache;
   auto it = cache.find(key);
@@ -71,7 +78,10 @@ inline const PreparedScene& prepared_scene(const std::string& key) {
   const auto underscore = key.find('_');
   const std::string family = key.substr(0, underscore);
   const int n = std::stoi(key.substr(underscore + 1));
-  PreparedScene s = family == "pyramid" ? pyramid_drop(n) : line_push(n, key.ends_with("_e1") ? 1.0 : 0.0);
+  const std::string base = key.substr(0, key.rfind("_mu") == std::string::npos ? key.size() : key.rfind("_mu"));
+  PreparedScene s = family == "pyramid" ? pyramid_drop(n) : line_push(n, base.ends_with("_e1") ? 1.0 : 0.0);
+  s.name = key;
+  for (RigidBody& b : s.bodies) b.material.friction = key_friction(key);
   return cache.emplace(key, std::move(s)).first->second;
 }
 

@@ -1,6 +1,7 @@
 // The `impetus` command-line tool: run a scene, resolve one impact, list plugins, mass properties of a mesh.
 // Contract: README.md, "The `impetus` tool", documents every option.
 
+#include "fclib_command.hpp"
 #include "mass_command.hpp"
 #include "report.hpp"
 
@@ -168,6 +169,13 @@ int resolve_command(const SceneArgs& args, bool json) {
   return 0;
 }
 
+int fclib_export_command(const SceneArgs& args, const cli::FclibExportArgs& export_args) {
+  const Scene scene = load(args);
+  PluginHost host;
+  std::unique_ptr<World> world = build_world(scene, host);
+  return cli::run_fclib_export(scene, *world, export_args);
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -203,6 +211,24 @@ int main(int argc, char** argv) {
   auto* plugins = app.add_subcommand("plugins", "list every plugin found and every library that failed to load");
   plugins->add_flag("--json", plugins_json, "print the listing as JSON");
 
+  auto* fclib = app.add_subcommand("fclib", "frictional contact problems in fclib's HDF5 form (Frictional Contact Library)");
+  fclib->require_subcommand(1);
+  cli::FclibSolveArgs fclib_solve_args;
+  auto* fclib_solve = fclib->add_subcommand("solve", "solve an fclib problem (local, or global reduced to local form)");
+  fclib_solve->add_option("file", fclib_solve_args.file, "fclib problem (HDF5)")->required()->check(CLI::ExistingFile);
+  fclib_solve->add_option("--tol", fclib_solve_args.tolerance, "tolerance on fclib's merit (default 1e-10)")
+      ->check(CLI::PositiveNumber);
+  fclib_solve->add_option("--resolver", fclib_solve_args.resolver, "resolver plugin that solves it (default ledas)")
+      ->type_name("NAME");
+  fclib_solve->add_flag("--json", fclib_solve_args.json, "print the result, impulses and velocities as JSON");
+  SceneArgs fclib_export_scene;
+  cli::FclibExportArgs fclib_export_args;
+  auto* fclib_export = fclib->add_subcommand("export", "write a scene's contact problem after one detection as an fclib problem");
+  add_scene_options(fclib_export, fclib_export_scene, true);
+  fclib_export->add_option("--out", fclib_export_args.out, "the HDF5 file to write")->required();
+  fclib_export->add_flag("--global", fclib_export_args.global, "write the global form (M, H, f, w) instead of the local one (W, q)");
+  fclib_export->add_flag("--overwrite", fclib_export_args.overwrite, "allow --out to replace an existing file");
+
   cli::MassArgs mass_args;
   auto* mass = cli::add_mass_command(app, mass_args);
 
@@ -216,6 +242,8 @@ int main(int argc, char** argv) {
     if (run->parsed()) return run_command(run_args, steps, duration, out_file, overwrite, every, run_json);
     if (resolve->parsed()) return resolve_command(resolve_args, resolve_json);
     if (mass->parsed()) return cli::run_mass_command(mass_args);
+    if (fclib_solve->parsed()) return cli::run_fclib_solve(fclib_solve_args);
+    if (fclib_export->parsed()) return fclib_export_command(fclib_export_scene, fclib_export_args);
     if (plugins->parsed()) {
       PluginHost host;
       const PluginListing listing = host.discover();

@@ -199,4 +199,52 @@ TEST(Cli, ResolveWithoutADetectorIsAClearError) {
   EXPECT_NE(r.out.find("detector"), std::string::npos) << r.out;
 }
 
+// `impetus fclib export` then `impetus fclib solve --json`: the contract's fields, the problem's size as
+// exported, and a solution that meets fclib's merit at the asked tolerance; impulses in the cones.
+TEST(Cli, FclibExportThenSolveMeetsTheToleranceOnFclibsMerit) {
+  const fs::path f = temp_file("pyramid.hdf5");
+  fs::remove(f);
+  const std::string pyramid = std::string(IMPETUS_SOURCE_DIR) + "/assets/scenes/pyramid_drop_10.yaml";
+  const Result exported = run("fclib export " + pyramid +
+                              " --set generators.0.pyramid.rows=4 --set generators.0.pyramid.friction=0.5 --out " + f.string());
+  ASSERT_EQ(exported.status, 0) << exported.out;
+  EXPECT_NE(exported.out.find("local problem of"), std::string::npos) << exported.out;
+  const Result solved = run("fclib solve " + f.string() + " --tol 1e-9 --json");
+  ASSERT_EQ(solved.status, 0) << solved.out;
+  const auto j = nlohmann::json::parse(solved.out);
+  for (const char* key : {"file", "contacts", "error", "iterations", "time_s", "converged", "reaction", "velocity"})
+    EXPECT_TRUE(j.contains(key)) << key;
+  const std::size_t contacts = j["contacts"];
+  EXPECT_NE(exported.out.find("problem of " + std::to_string(contacts) + " contacts"), std::string::npos) << exported.out;
+  EXPECT_TRUE(j["converged"].get<bool>());
+  EXPECT_LE(j["error"].get<double>(), 1e-9);
+  ASSERT_EQ(j["reaction"].size(), 3 * contacts);
+  ASSERT_EQ(j["velocity"].size(), 3 * contacts);
+  for (std::size_t c = 0; c < contacts; ++c) {  // r in the cone ‖r_t‖ ≤ 0.5 r_n, u_n ≥ 0 (to the tolerance)
+    const double rn = j["reaction"][3 * c], rt = std::hypot(j["reaction"][3 * c + 1].get<double>(), j["reaction"][3 * c + 2].get<double>());
+    EXPECT_GE(rn, -1e-12);
+    EXPECT_LE(rt, 0.5 * rn + 1e-9);
+    EXPECT_GE(j["velocity"][3 * c].get<double>(), -1e-8);
+  }
+}
+
+TEST(Cli, FclibRefusesWhatItCannotUse) {
+  const fs::path f = temp_file("keep.hdf5");
+  { std::ofstream(f) << "precious\n"; }
+  const std::string pyramid = std::string(IMPETUS_SOURCE_DIR) + "/assets/scenes/pyramid_drop_10.yaml";
+  Result r = run("fclib export " + pyramid + " --out " + f.string());
+  EXPECT_NE(r.status, 0);
+  EXPECT_NE(r.out.find("exists already"), std::string::npos) << r.out;
+  EXPECT_EQ(read(f), "precious\n");
+
+  r = run("fclib solve " + f.string());  // not HDF5
+  EXPECT_NE(r.status, 0);
+  EXPECT_NE(r.out.find(f.string() + ": not an HDF5 file"), std::string::npos) << r.out;
+
+  const std::string chain = std::string(IMPETUS_SOURCE_DIR) + "/assets/scenes/pendulum_chain.yaml";
+  r = run("fclib export " + chain + " --out " + temp_file("chain.hdf5").string());
+  EXPECT_NE(r.status, 0);
+  EXPECT_NE(r.out.find("constraints"), std::string::npos) << r.out;
+}
+
 }  // namespace

@@ -261,4 +261,12 @@ const StepStatus& World::detect_and_resolve() {
   return status_;
 }
 
+const StepStatus& World::detect_contacts() {
+  const auto start = Clock::now();
+  status_ = StepStatus{};
+  detect(status_);
+  status_.profile.total = seconds_since(start);
+  return status_;
+}
+
 }  // namespace impetus

@@ -4,6 +4,7 @@
 
 #include "impetus/core/body.hpp"
 #include "impetus/modules/constraint.hpp"
+#include "impetus/modules/contact_problem.hpp"
 #include "impetus/modules/contact.hpp"
 #include "impetus/modules/status.hpp"
 #include "impetus/modules/step.hpp"
@@ -31,6 +32,17 @@ class CollisionResolver {
   /// silently ignored. The default refuses.
   virtual ModuleStatus accept_friction() noexcept {
     return ModuleStatus::failure("this resolver does not model friction");
+  }
+
+  /// Solves a frictional contact problem given directly in local form (contact_problem.hpp), e.g. one read
+  /// from an fclib file, writing `solution`. Fails (saying why) if this resolver has no such solver or
+  /// the problem is outside what it solves; an unsolved problem is a success with converged = false and
+  /// its best iterate. The default refuses.
+  virtual ModuleStatus solve_contact_problem(const LocalContactProblem& problem,
+                                             LocalContactSolution& solution) noexcept {
+    (void)problem;
+    (void)solution;
+    return ModuleStatus::failure("this resolver does not solve contact problems in local form");
   }
 
   /// Applies impulses to `bodies` for `contacts` (writing each contact's total `impulse`,

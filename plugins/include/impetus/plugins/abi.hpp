@@ -23,8 +23,9 @@ class ModuleOptions;
 
 /// Version of this ABI. Bump on any change to PluginDescriptor or to the module interfaces.
 /// 2: the descriptor carries the layout words. 3: friction (CollisionResolver::accept_friction, the
-/// contact's tangential impulse and mode, the resolver's friction counters).
-inline constexpr std::uint32_t kPluginAbiVersion = 3;
+/// contact's tangential impulse and mode, the resolver's friction counters). 4: local contact problems
+/// (CollisionResolver::solve_contact_problem, LocalContactProblem, LocalContactSolution).
+inline constexpr std::uint32_t kPluginAbiVersion = 4;
 
 /// Name of the entry symbol every plugin exports.
 inline constexpr const char* kPluginEntrySymbol = "impetus_plugin_descriptor";
@@ -48,6 +49,7 @@ enum class LayoutType : std::uint32_t {
   rigid_body, material, shape, sphere, box, capsule, cylinder, plane, mesh_shape, triangle_mesh,
   contact, point_point_constraint, coaxial_constraint, constraint, step_context, integrator_counters,
   detector_counters, resolver_counters, module_status, module_options, option_value, body_pair,
+  local_contact_problem, local_contact_solution,
   count  ///< not a type: the number of layout words
 };
 /// Number of layout words in a descriptor.
@@ -59,7 +61,7 @@ inline constexpr std::array<const char*, kLayoutTypeCount> kLayoutTypeNames{
     "impetus::Contact", "impetus::PointPointConstraint", "impetus::CoaxialConstraint", "impetus::Constraint",
     "impetus::StepContext", "impetus::IntegratorCounters", "impetus::DetectorCounters",
     "impetus::ResolverCounters", "impetus::ModuleStatus", "impetus::ModuleOptions", "impetus::OptionValue",
-    "impetus::BodyPair"};
+    "impetus::BodyPair", "impetus::LocalContactProblem", "impetus::LocalContactSolution"};
 /// One layout word per LayoutType (plugin_layout_words() of a build).
 using LayoutWords = std::array<std::uint64_t, kLayoutTypeCount>;
 

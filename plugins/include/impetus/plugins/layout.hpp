@@ -13,6 +13,7 @@
 #include "impetus/core/shape.hpp"
 #include "impetus/modules/constraint.hpp"
 #include "impetus/modules/contact.hpp"
+#include "impetus/modules/contact_problem.hpp"
 #include "impetus/modules/detector.hpp"
 #include "impetus/modules/options.hpp"
 #include "impetus/modules/status.hpp"
@@ -108,6 +109,12 @@ inline LayoutWords plugin_layout_words() {
   at(LayoutType::option_value) = layout_word<OptionValue>(&OptionValue::text, &OptionValue::items,
                                                           &OptionValue::is_list, &OptionValue::where);
   at(LayoutType::body_pair) = layout_word<BodyPair>(&BodyPair::first, &BodyPair::second);
+  using LP = LocalContactProblem;
+  at(LayoutType::local_contact_problem) = layout_word<LP>(&LP::contacts, &LP::equalities, &LP::w_columns, &LP::w_rows,
+                                                          &LP::w_values, &LP::q, &LP::mu, &LP::tolerance);
+  using LS = LocalContactSolution;
+  at(LayoutType::local_contact_solution) =
+      layout_word<LS>(&LS::r, &LS::u, &LS::residual, &LS::iterations, &LS::converged);
   return w;
 }
 

@@ -82,6 +82,9 @@ class World {
   /// One detection and one resolution at the current state, no integration (the paper's experiment,
   /// `impetus resolve`). Time does not advance.
   const StepStatus& detect_and_resolve();
+  /// One detection at the current state and nothing else: contacts() are what the resolver would be
+  /// given (`impetus fclib export`). Velocities and time do not change.
+  const StepStatus& detect_contacts();
 
   std::span<RigidBody> bodies() { return bodies_; }
   std::span<const RigidBody> bodies() const { return bodies_; }

@@ -33,6 +33,7 @@
 /// steps per problem; whatever happens, the iterate with the smallest residual is returned and a failure
 /// to reach the tolerance is counted, never hidden.
 
+#include "impetus/modules/contact_problem.hpp"
 #include "impetus/resolution/ledas/island_solver.hpp"
 
 #include <cstdint>
@@ -136,5 +137,13 @@ class FrictionalSolver {
   FrictionalSettings settings_;
   std::uint64_t steps_left_ = 0;  // Newton steps left to the current solve (max_newton_steps)
 };
+
+/// Solves a problem given in local form (impetus/modules/contact_problem.hpp; fclib's layout, e.g. read
+/// from a file), writing `solution` (r, u = W r + q, residual, iterations, converged). A contact with
+/// μ = 0 keeps r_t = 0 and leaves u_t free; equality rows are joint rows. Throws std::invalid_argument
+/// naming the defect for arrays that disagree (column pointers, row indices out of range, non-finite
+/// values, negative μ, W not symmetric), before any of them is used as an index.
+void solve_local_problem(FrictionalSolver& solver, const LocalContactProblem& problem,
+                         LocalContactSolution& solution, FrictionalStats& stats);
 
 }  // namespace impetus::ledas

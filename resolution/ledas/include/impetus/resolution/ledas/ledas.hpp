@@ -136,6 +136,11 @@ class LedasResolver final : public CollisionResolver {
   /// formulas for its rounds).
   ModuleStatus accept_friction() noexcept override;
 
+  /// Solves a frictional contact problem in local form with the frictional solver (complementary mode;
+  /// ledas::solve_local_problem); last_stats().friction gets its counts.
+  ModuleStatus solve_contact_problem(const LocalContactProblem& problem,
+                                     LocalContactSolution& solution) noexcept override;
+
   /// Resolves `contacts` and `constraints` (see the class comment), writing Contact::impulse.
   void resolve(std::span<RigidBody> bodies, std::span<Contact> contacts, std::span<const Constraint> constraints,
                const StepContext& ctx, ResolverCounters& counters) noexcept override;
