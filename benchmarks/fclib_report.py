@@ -5,7 +5,7 @@
                 --benchmark_out_format=json --benchmark_out=fclib.json
     benchmarks/fclib_report.py fclib.json [--chart fclib_profile.png]
 
-Times are medians over the repetitions (wall time of one solve, ms); the counters are the median
+Times are medians over the repetitions (CPU time of one solve, ms: robust on a shared machine); the counters are the median
 aggregate's (they do not vary between repetitions). The performance profile is the fraction of the
 problems solved to fclib's error 1e-8 (the tolerance of the published comparison of solvers) and 1e-10
 within a time t, against t.
@@ -42,7 +42,7 @@ def table(rows):
            "|---|---|---|---|---|---|---|---|---|---|"]
     for name, b in rows.items():
         contacts = int(b["contacts"])
-        ms = b["real_time"]
+        ms = b["cpu_time"]
         out.append("| {} | {} | {} | {} | {} | {} | {} | {} | {} | {} |".format(
             name, contacts, fmt(ms), fmt(100.0 * ms / max(contacts, 1)), fmt(b["error"]), int(b["iterations"]),
             int(b["sticking"]), int(b["sliding"]), "yes" if b["solved_1e8"] else "**no**",
@@ -59,19 +59,21 @@ def profile(rows, path):
     import matplotlib.pyplot as plt
     fig, ax = plt.subplots(figsize=(8, 5))
     n = len(rows)
-    for key, label in (("solved_1e8", "error ≤ 1e-8"), ("exact", "error ≤ 1e-10")):
-        times = sorted(b["real_time"] for b in rows.values() if b[key])
+    # Drawn wide then narrow: where every problem solved to 1e-8 is also solved to 1e-10, both show.
+    for key, label, style in (("solved_1e8", "error ≤ 1e-8", dict(linewidth=4, alpha=0.5)),
+                              ("exact", "error ≤ 1e-10", dict(linewidth=1.5))):
+        times = sorted(b["cpu_time"] for b in rows.values() if b[key])
         xs, ys = [], []
         for i, t in enumerate(times):
             xs += [t, t]
             ys += [i / n, (i + 1) / n]
         if xs:
-            xs.append(max(b["real_time"] for b in rows.values()) * 2)
+            xs.append(max(b["cpu_time"] for b in rows.values()) * 2)
             ys.append(len(times) / n)
-        ax.step(xs, ys, where="post", label=label)
+        ax.step(xs, ys, where="post", label=label, **style)
     ax.set_xscale("log")
     ax.set_ylim(0, 1.02)
-    ax.set_xlabel("time per problem (ms, median)")
+    ax.set_xlabel("CPU time per problem (ms, median)")
     ax.set_ylabel(f"fraction of the {n} problems solved")
     ax.set_title("ledas on fclib problems: performance profile")
     ax.grid(True, which="both", alpha=0.3)

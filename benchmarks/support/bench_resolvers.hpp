@@ -25,6 +25,9 @@ inline std::unique_ptr<CollisionResolver> make_resolver(const std::string& name,
   // it at 2·10⁵ rounds per island so the large rows end in seconds and show non_converged instead.
   if (s.mode == LedasMode::paper) s.max_rounds = 200000;
   if (velocity_only) s.resting.correction = 0.0;
+  // Each timed iteration solves the same problem again: a warm start from the previous iteration's
+  // answer would time a lookup of the answer, so the frictional solve starts cold every time.
+  if (velocity_only) s.warm_start = false;
   return std::make_unique<LedasResolver>(s);
 }
 
