@@ -12,8 +12,11 @@ within a time t, against t.
 """
 import argparse
 import json
-import math
+import os
 import sys
+
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "peers"))
+from report import fmt  # noqa: E402  (benchmarks/peers/report.py: numbers as the other tables print them)
 
 
 def load(path):
@@ -27,14 +30,6 @@ def load(path):
             continue
         rows[b["run_name"].split("/", 1)[1]] = b  # a median aggregate replaces a single run's row
     return rows
-
-
-def fmt(x):
-    if x is None or (isinstance(x, float) and math.isnan(x)):
-        return "nan"
-    if x == 0:
-        return "0"
-    return f"{x:.3g}" if 1e-3 <= abs(x) < 1e4 else f"{x:.1e}"
 
 
 def table(rows):

@@ -93,15 +93,20 @@ std::string label(const Case& c) {
   return out;
 }
 
+// The case's contact problem after one detection.
+fclib::SceneProblem detected_problem(const Case& c, PluginHost& host) {
+  std::unique_ptr<World> world = make_world(c, host);
+  world->detect_contacts();
+  return fclib::scene_problem(world->bodies(), world->contacts(), world->settings().dt);
+}
+
 double largest(const fclib::SparseMatrix& a) { return a.nonZeros() > 0 ? a.coeffs().cwiseAbs().maxCoeff() : 0.0; }
 
 TEST(Fclib, ASceneProblemSurvivesTheFileBitForBitInBothForms) {
   for (const Case& c : cases()) {
     SCOPED_TRACE(label(c));
     PluginHost host;
-    std::unique_ptr<World> world = make_world(c, host);
-    world->detect_contacts();
-    const fclib::SceneProblem problem = fclib::scene_problem(world->bodies(), world->contacts(), world->settings().dt);
+    const fclib::SceneProblem problem = detected_problem(c, host);
     ASSERT_GT(problem.contacts.size(), 0u);
 
     const fs::path local_file = temp_file("local.hdf5"), global_file = temp_file("global.hdf5");
@@ -135,9 +140,7 @@ TEST(Fclib, TheExportedProblemIsTheProblemResolveSolves) {
   for (const Case& c : cases()) {
     SCOPED_TRACE(label(c));
     PluginHost host;
-    std::unique_ptr<World> world = make_world(c, host);
-    world->detect_contacts();
-    const fclib::SceneProblem problem = fclib::scene_problem(world->bodies(), world->contacts(), world->settings().dt);
+    const fclib::SceneProblem problem = detected_problem(c, host);
     const fs::path file = temp_file("roundtrip.hdf5");
     fclib::write_problem(file, problem.local);
     const fclib::LocalProblem read = fclib::read_problem(file).local;
@@ -186,9 +189,7 @@ TEST(Fclib, TheExportedProblemIsTheProblemResolveSolves) {
 // impulses that solve nothing, where both are far from zero.
 TEST(Fclib, FclibsMeritIsTheNaturalMapResidualScaledAsFclibScalesIt) {
   PluginHost host;
-  std::unique_ptr<World> world = make_world(cases()[2], host);
-  world->detect_contacts();
-  const fclib::SceneProblem problem = fclib::scene_problem(world->bodies(), world->contacts(), world->settings().dt);
+  const fclib::SceneProblem problem = detected_problem(cases()[2], host);
   const fclib::LocalProblem& local = problem.local;
   std::mt19937 random(3);
   std::uniform_real_distribution<double> unit(-1.0, 1.0);

@@ -272,26 +272,41 @@ fclib_matrix view_of(const SparseMatrix& a) {
   return view;
 }
 
-// The contact block W, the mixed blocks V, R and the vectors q, s of a stored local problem.
-struct Blocks {
-  SparseMatrix w, v, r;
-  Vector q, s;
+// A local problem as libfclib's struct: the contact block W, the mixed blocks V, R and the vectors q, s
+// split out of LocalProblem's [W V; Vᵀ R] and [q; s] (owned here; `local` points into them).
+class LocalView {
+ public:
+  explicit LocalView(const LocalProblem& problem) {
+    const auto c = static_cast<Eigen::Index>(3 * problem.contacts()), e = static_cast<Eigen::Index>(problem.equalities);
+    SparseMatrix whole = problem.w;
+    whole.makeCompressed();
+    w_ = whole.topLeftCorner(c, c);
+    v_ = whole.topRightCorner(c, e);
+    r_ = whole.bottomRightCorner(e, e);
+    for (SparseMatrix* a : {&w_, &v_, &r_}) a->makeCompressed();
+    q_ = problem.q.head(c);
+    s_ = problem.q.tail(e);
+    w_view_ = view_of(w_);
+    v_view_ = view_of(v_);
+    r_view_ = view_of(r_);
+    local.W = &w_view_;
+    local.V = e > 0 ? &v_view_ : nullptr;
+    local.R = e > 0 ? &r_view_ : nullptr;
+    local.mu = const_cast<double*>(problem.mu.data());
+    local.q = q_.data();
+    local.s = e > 0 ? s_.data() : nullptr;
+    local.spacedim = 3;
+  }
+  LocalView(const LocalView&) = delete;
+  LocalView& operator=(const LocalView&) = delete;
+
+  fclib_local local{};
+
+ private:
+  SparseMatrix w_, v_, r_;
+  Vector q_, s_;
+  fclib_matrix w_view_{}, v_view_{}, r_view_{};
 };
-Blocks split(const LocalProblem& problem) {
-  const auto c = static_cast<Eigen::Index>(3 * problem.contacts()), e = static_cast<Eigen::Index>(problem.equalities);
-  SparseMatrix w = problem.w;
-  w.makeCompressed();
-  Blocks b;
-  b.w = w.topLeftCorner(c, c);
-  b.v = w.topRightCorner(c, e);
-  b.r = w.bottomRightCorner(e, e);
-  b.w.makeCompressed();
-  b.v.makeCompressed();
-  b.r.makeCompressed();
-  b.q = problem.q.head(c);
-  b.s = problem.q.tail(e);
-  return b;
-}
 
 struct InfoStrings {
   std::string title, description, math_info;
@@ -383,19 +398,10 @@ FileProblem read_problem(const std::filesystem::path& file) {
 
 void write_problem(const std::filesystem::path& file, const LocalProblem& problem) {
   refuse_existing(file);
-  Blocks b = split(problem);
-  fclib_matrix w = view_of(b.w), v = view_of(b.v), r = view_of(b.r);
+  LocalView view(problem);
   InfoStrings info(problem.info);
-  fclib_local local{};
-  local.W = &w;
-  local.V = problem.equalities > 0 ? &v : nullptr;
-  local.R = problem.equalities > 0 ? &r : nullptr;
-  local.mu = const_cast<double*>(problem.mu.data());
-  local.q = b.q.data();
-  local.s = problem.equalities > 0 ? b.s.data() : nullptr;
-  local.spacedim = 3;
-  local.info = &info.info;
-  written(file, fclib_write_local(&local, file.c_str()));
+  view.local.info = &info.info;
+  written(file, fclib_write_local(&view.local, file.c_str()));
 }
 
 void write_problem(const std::filesystem::path& file, const GlobalProblem& problem) {
@@ -421,16 +427,7 @@ void write_problem(const std::filesystem::path& file, const GlobalProblem& probl
 }
 
 double merit(const LocalProblem& problem, const Vector& r) {
-  Blocks b = split(problem);
-  fclib_matrix w = view_of(b.w), v = view_of(b.v), rm = view_of(b.r);
-  fclib_local local{};
-  local.W = &w;
-  local.V = problem.equalities > 0 ? &v : nullptr;
-  local.R = problem.equalities > 0 ? &rm : nullptr;
-  local.mu = const_cast<double*>(problem.mu.data());
-  local.q = b.q.data();
-  local.s = problem.equalities > 0 ? b.s.data() : nullptr;
-  local.spacedim = 3;
+  LocalView view(problem);
   const auto c = static_cast<Eigen::Index>(3 * problem.contacts());
   Vector contact_r = r.head(c), lambda = r.tail(static_cast<Eigen::Index>(problem.equalities));
   Vector u = (problem.w * r + problem.q).head(c);
@@ -438,7 +435,7 @@ double merit(const LocalProblem& problem, const Vector& r) {
   solution.r = contact_r.data();
   solution.u = u.data();
   solution.l = problem.equalities > 0 ? lambda.data() : nullptr;
-  return fclib_merit_local(&local, MERIT_1, &solution);
+  return fclib_merit_local(&view.local, MERIT_1, &solution);
 }
 
 }  // namespace impetus::fclib
