@@ -8,6 +8,7 @@
 
 #include "impetus/core/math.hpp"
 
+#include <functional>
 #include <memory>
 #include <optional>
 #include <string>
@@ -49,6 +50,12 @@ std::unique_ptr<Probe> joint_gap_probe();
 /// A torque-free body: `momentum_drift` = max |L − L0| / |L0|, `energy_drift` = max |E − E0| / E0 over
 /// the run (L about the world origin; the body does not translate).
 std::unique_ptr<Probe> tumble_probe();
+
+/// One body's velocity against a closed form: `velocity_error` = |v(end) − expected(t_end)| (m/s), and
+/// `rolling_error` = |v + ω × (−radius e_z)| at the end (m/s; the slip of a sphere's contact point on
+/// flat ground, reported when `radius` > 0).
+std::unique_ptr<Probe> velocity_probe(const std::string& body, std::function<Vec3(double)> expected,
+                                      double radius = 0.0);
 
 /// Total energy (kinetic + potential, zero at z = 0) should never increase: `energy_rise` = max over t of
 /// E(t) − min_{s ≤ t} E(s), relative to E0; `max_penetration` (m).

@@ -242,7 +242,79 @@ std::vector<Scenario> scenarios(bool quick) {
     out.push_back(std::move(s));
   }
 
-  // 10. A non-convex mesh bouncing with e = 0.5.
+  // 10. Friction (docs/conventions.md, "Friction"): closed forms and statics. The paper mode refuses
+  // friction, so these run with the complementary mode and the sequential baseline.
+  const std::vector<std::string> frictional{"ledas/complementary", "mirtich"};
+  {
+    Scenario s = simulation("friction_slope_slide", "friction", "Box sliding down a 30° slope, μ = 0.5, 1 s",
+                            "friction_slope.yaml", 1.0, 1.0 / 1000, {1.0 / 60, 1.0 / 240, 1.0 / 1000}, quick);
+    s.resolvers = frictional;
+    s.sweep = IntegratorSweep::reference;
+    s.measures = "the box's velocity against a = g (sin 30° − μ cos 30°) t";
+    s.error_doc = {{"velocity_error", "|v - a t| at the end (m/s)"}};
+    s.primary = "velocity_error";
+    s.criterion = "velocity within 1e-6 m/s of the closed form";
+    s.bounds = {{"velocity_error", 1e-6}};
+    const double a = 9.81 * (0.5 - 0.5 * std::sqrt(3.0) / 2.0);
+    s.probe = [a] { return velocity_probe("box", [a](double t) { return Vec3(a * t, 0, 0); }); };
+    out.push_back(std::move(s));
+  }
+  {
+    Scenario s = simulation("friction_slope_stick", "friction", "Box on a 30° slope, μ = 0.7 > tan 30°: sticks, 5 s",
+                            "friction_slope.yaml", quick ? 1.0 : 5.0, 1.0 / 1000, {1.0 / 60, 1.0 / 240, 1.0 / 1000}, quick);
+    s.overrides = {{"bodies.box.friction", "0.7"}, {"bodies.ground.friction", "0.7"}};
+    s.resolvers = frictional;
+    s.sweep = IntegratorSweep::reference;
+    s.measures = "creep of the box down the slope";
+    s.error_doc = kRestingDoc;
+    s.primary = "top_drift";
+    s.criterion = "the box moves less than 1e-6 m";
+    s.bounds = {{"top_drift", 1e-6}};
+    s.probe = [] { return resting_probe("box", std::nullopt, 0.5); };
+    out.push_back(std::move(s));
+  }
+  {
+    Scenario s = simulation("friction_sphere_roll", "friction", "Sphere thrown sliding at 2 m/s, μ = 0.2: rolls at 5/7 v0, 1 s",
+                            "friction_sphere.yaml", 1.0, 1.0 / 1000, {1.0 / 60, 1.0 / 240, 1.0 / 1000}, quick);
+    s.resolvers = frictional;
+    s.sweep = IntegratorSweep::reference;
+    s.measures = "final velocity against 5/7 v0, and the slip of the contact point";
+    s.error_doc = {{"velocity_error", "|v - (5/7) v0| at the end (m/s)"},
+                   {"rolling_error", "|v + w x (-r e_z)| at the end: slip left (m/s)"}};
+    s.primary = "velocity_error";
+    s.criterion = "velocity within 1e-6 m/s of 5/7 v0, slip below 1e-6 m/s";
+    s.bounds = {{"velocity_error", 1e-6}, {"rolling_error", 1e-6}};
+    s.probe = [] { return velocity_probe("ball", [](double) { return Vec3(10.0 / 7.0, 0, 0); }, 0.1); };
+    out.push_back(std::move(s));
+  }
+  {
+    Scenario s = simulation("friction_card_house", "friction", "Card house (two leaning cards and a plank), μ = 0.7: stands",
+                            "friction_card_house.yaml", quick ? 1.0 : 5.0, 1.0 / 240, {1.0 / 60, 1.0 / 120, 1.0 / 240}, quick);
+    s.resolvers = frictional;
+    s.sweep = IntegratorSweep::reference;
+    s.measures = "drift of the plank on top, penetration, kinetic energy at rest";
+    s.error_doc = kRestingDoc;
+    s.primary = "top_drift";
+    s.criterion = "the plank within 1 mm of its start; penetration <= 1 mm";
+    s.bounds = {{"top_drift", 1e-3}, {"max_penetration", 1e-3}};
+    s.probe = [] { return resting_probe("plank", std::nullopt, 0.5); };
+    out.push_back(std::move(s));
+  }
+  {
+    Scenario s = simulation("friction_pyramid_10", "friction", "Sphere pyramid K = 10 at rest, μ = 0.7: stands",
+                            "friction_pyramid_10.yaml", quick ? 1.0 : 10.0, 1.0 / 60, resting_dts, quick);
+    s.resolvers = frictional;
+    s.sweep = IntegratorSweep::reference;
+    s.measures = "drift of the top sphere, penetration, kinetic energy at rest";
+    s.error_doc = kRestingDoc;
+    s.primary = "top_drift";
+    s.criterion = "top sphere within 1 mm of its start; penetration <= 1 mm";
+    s.bounds = {{"top_drift", 1e-3}, {"max_penetration", 1e-3}};
+    s.probe = [] { return resting_probe("pyramid_r9_0", std::nullopt, 0.5); };
+    out.push_back(std::move(s));
+  }
+
+  // 11. A non-convex mesh bouncing with e = 0.5.
   {
     const double duration = quick ? 1.5 : 3.0;
     Scenario s = simulation("bracket_bounce", "bracket", "L bracket (triangle mesh) bouncing, e = 0.5, " +

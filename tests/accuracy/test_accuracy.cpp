@@ -181,5 +181,19 @@ TEST(Accuracy, BracketEnergyNeverRises) {
       expect_pass("bracket_bounce", method(r, integrator));
 }
 
+// Friction: the simultaneous resolver meets every closed form and statics (slope slide to 1e-6 m/s, stick,
+// slide-to-roll at 5/7 v0, the card house and the resting pyramid stand); the sequential baseline meets
+// the one-contact sphere, and fails where several contacts share the friction: the box on the slope
+// slides wrong by more than 1e-3 m/s, creeps where it should stick, and the pyramid collapses.
+TEST(Accuracy, FrictionClosedFormsAndStatics) {
+  for (const char* id : {"friction_slope_slide", "friction_slope_stick", "friction_sphere_roll", "friction_card_house",
+                         "friction_pyramid_10"})
+    expect_pass(id, method("ledas/complementary"));
+  expect_pass("friction_sphere_roll", method("mirtich"));
+  expect_fail("friction_slope_slide", method("mirtich"), "velocity_error", 1e-3);
+  expect_fail("friction_slope_stick", method("mirtich"), "top_drift", 1e-4);
+  expect_fail("friction_pyramid_10", method("mirtich"), "top_drift", 0.1);
+}
+
 }  // namespace
 }  // namespace impetus::accuracy
