@@ -24,7 +24,9 @@ class ModuleOptions;
 /// Version of this ABI. Bump on any change to PluginDescriptor or to the module interfaces.
 /// 2: the descriptor carries the layout words. 3: friction (CollisionResolver::accept_friction, the
 /// contact's tangential impulse and mode, the resolver's friction counters).
-inline constexpr std::uint32_t kPluginAbiVersion = 3;
+/// 5: ResolverCounters::redundant_systems (redundant contact sets solved by minimum norm, told apart from
+/// singular_systems, which now counts only real failures).
+inline constexpr std::uint32_t kPluginAbiVersion = 5;
 
 /// Name of the entry symbol every plugin exports.
 inline constexpr const char* kPluginEntrySymbol = "impetus_plugin_descriptor";
