@@ -29,6 +29,23 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
+// How to read the run summary (README.md, "The run summary", says the same at length).
+constexpr const char* kRunSummaryHelp = R"help(The summary:
+  energy     accounted, not just compared: dissipated by contacts (kinetic energy lost across the
+             resolve stage of each step), work of gravity (m g dh) and of applied loads, potential
+             energy added by position correction, and the remainder gained or lost by integration
+             (the only part called drift). Only what is unexpected is flagged: contacts gaining
+             energy, or integration gaining more than rounding beyond what the same steps' contacts
+             took back (gravity's kick on a resting body, which its contact removes each step).
+  momentum   impulses the movable bodies received from fixed bodies (and their moment about the
+             origin) are physics; drift is what gravity, applied loads and those impulses do not
+             explain.
+  resolver   "redundant contact sets (minimum-norm)": more contact rows than the bodies have degrees
+             of freedom (a box resting on four corners); the impulses are not unique and the
+             smallest ones are used. Normal. "singular (failed)": a system the resolver could not
+             satisfy (conflicting targets). With resolver none the detector still runs and the
+             summary says the contacts were detected and not resolved (detector none skips it).)help";
+
 struct SceneArgs {
   std::string scene;
   std::vector<std::string> sets;
@@ -94,6 +111,15 @@ class Progress {
   Clock::time_point start_ = Clock::now(), last_{};
 };
 
+// The options a scene or the command line gave a module (plugin defaults are not known here): a string
+// per scalar, an array of strings per list.
+nlohmann::json options_json(const ModuleOptions& options) {
+  nlohmann::json out = nlohmann::json::object();
+  for (const auto& [key, value] : options.values())
+    out[key] = value.is_list ? nlohmann::json(value.items) : nlohmann::json(value.text);
+  return out;
+}
+
 int run_command(const SceneArgs& args, std::optional<std::uint64_t> steps, std::optional<double> duration,
                 const std::string& out_file, bool overwrite, std::uint64_t every, bool json) {
   const Scene scene = load(args);
@@ -134,12 +160,14 @@ int run_command(const SceneArgs& args, std::optional<std::uint64_t> steps, std::
   summary["modules"] = {{"integrator", scene.integrator.plugin},
                         {"detector", scene.detector.plugin},
                         {"resolver", scene.resolver.plugin}};
+  summary["module_options"] = {{"integrator", options_json(scene.integrator.options)},
+                               {"detector", options_json(scene.detector.options)},
+                               {"resolver", options_json(scene.resolver.options)}};
+  // Without a resolver the detector still runs (World::contacts() shows what it found): say so.
+  summary["contacts_per_step"]["resolved"] = world->has_resolver() || !world->has_detector();
   if (json) {
     std::cout << summary.dump(2) << "\n";
   } else {
-    std::cout << "scene                 " << scene.file.string() << "\n"
-              << "modules               integrator " << scene.integrator.plugin << ", detector "
-              << scene.detector.plugin << ", resolver " << scene.resolver.plugin << "\n";
     cli::print_summary(summary, std::cout);
     if (!out_file.empty()) std::cout << "trajectory            " << out_file << "\n";
   }
@@ -191,6 +219,7 @@ int main(int argc, char** argv) {
   std::uint64_t every = 1;
   auto* run = app.add_subcommand("run", "simulate a scene (no SCENE: the bundled demo) and print a summary");
   add_scene_options(run, run_args, false);
+  run->footer(kRunSummaryHelp);
   auto* steps_opt = run->add_option("--steps", steps, "number of steps (default 1000)")->check(CLI::NonNegativeNumber);
   run->add_option("--duration", duration, "simulated time in seconds")->excludes(steps_opt);
   run->add_option("--dt", run_args.dt, "time step in seconds (overrides dt)")->check(CLI::PositiveNumber);

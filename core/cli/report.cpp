@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <array>
 #include <charconv>
+#include <cmath>
 #include <cstdio>
 #include <iomanip>
 #include <ostream>
@@ -26,16 +27,51 @@ void append_number(std::string& line, double x) {
 }  // namespace
 
 RunStats::RunStats(const World& world) : initial_(measure(world)) {
-  for (const RigidBody& b : world.bodies())
+  for (const RigidBody& b : world.bodies()) {
+    initial_positions_.push_back(b.position);
     if (!b.fixed) total_mass_ += b.mass;
+  }
 }
 
 void RunStats::before_step(const World& world) {
   const double dt = world.settings().dt;
   const Vec3 g = world.settings().gravity;
   gravity_impulse_ += dt * total_mass_ * g;
-  for (const RigidBody& b : world.bodies())
-    if (!b.fixed) gravity_moment_ += dt * b.position.cross(b.mass * g);
+  for (const RigidBody& b : world.bodies()) {
+    if (b.fixed) continue;
+    gravity_moment_ += dt * b.position.cross(b.mass * g);
+    load_impulse_ += dt * b.force;
+    load_moment_ += dt * (b.position.cross(b.force) + b.torque);
+  }
+  step_kinetic_ = total_kinetic_energy(world.bodies());
+  step_potential_ = load_potential_energy(world.bodies(), g);
+}
+
+// The step's integration remainder is the change of kinetic + load potential energy outside the resolve
+// stage, less the work of torques. Where the step's contacts dissipated energy, a gain up to that much
+// is the split step's exchange (velocities before contacts), set apart so that it is not flagged.
+void RunStats::add_integration_step(const World& world, const StepStatus& status, double torque_work) {
+  const double kinetic = total_kinetic_energy(world.bodies());
+  const double potential = load_potential_energy(world.bodies(), world.settings().gravity);
+  const double remainder = (kinetic - step_kinetic_) + (potential - step_potential_) -
+                           status.resolve_kinetic_energy_change - status.resolve_potential_energy_change -
+                           torque_work;
+  const double taken_back = std::max(0.0, -status.resolve_kinetic_energy_change);
+  contact_exchange_ += std::clamp(remainder, 0.0, taken_back);
+}
+
+// Contact convention (modules/contact.hpp): the impulse P = p n + p_t acts +P on b and −P on a. Only a
+// movable body's share counts: what it receives from a fixed body enters the system from outside.
+void RunStats::add_fixed_body_impulses(const World& world) {
+  const auto bodies = world.bodies();
+  for (const Contact& c : world.contacts()) {
+    const bool a_fixed = bodies[c.a].fixed, b_fixed = bodies[c.b].fixed;
+    if (a_fixed == b_fixed) continue;  // internal (cancels) or between two fixed bodies (acts on nothing)
+    const Vec3 impulse = c.impulse * c.normal + c.tangent_impulse;
+    const Vec3 received = a_fixed ? impulse : Vec3(-impulse);
+    fixed_impulse_ += received;
+    fixed_moment_ += c.point.cross(received);
+  }
 }
 
 void RunStats::add_step(const World& world, const StepStatus& status) {
@@ -52,6 +88,7 @@ void RunStats::add_step(const World& world, const StepStatus& status) {
   max_rounds_ = std::max(max_rounds_, status.resolver.rounds);
   non_converged_ += status.resolver.non_converged;
   singular_ += status.resolver.singular_systems;
+  redundant_ += status.resolver.redundant_systems;
   pulling_ += status.resolver.pulling_impulses;
   energy_gains_ += status.resolver.energy_gain_events;
   sticking_ += status.resolver.sticking;
@@ -60,12 +97,88 @@ void RunStats::add_step(const World& world, const StepStatus& status) {
   max_natural_map_ = std::max(max_natural_map_, status.resolver.natural_map_residual);
   max_residual_ = std::max(max_residual_, status.resolver.residual);
   for (const Contact& c : world.contacts()) max_penetration_ = std::max(max_penetration_, c.depth);
+  contact_energy_change_ += status.resolve_kinetic_energy_change;
+  contact_energy_scale_ += std::abs(status.resolve_kinetic_energy_change);
+  correction_energy_ += status.resolve_potential_energy_change;
+  add_fixed_body_impulses(world);
+  double torque_work = 0.0;
+  for (const RigidBody& b : world.bodies())
+    if (!b.fixed) torque_work += world.settings().dt * b.torque.dot(b.angular_velocity);
+  torque_work_ += torque_work;
+  add_integration_step(world, status, torque_work);
+}
+
+// The energy balance ΔKE = contacts + position correction + gravity + loads + integration. Gravity and
+// constant forces do work m g·Δx and F·Δx over the run; torques τ·ω dt per step. Integration is what
+// none of them explains, and the only part called drift.
+json RunStats::energy_summary(const World& world) const {
+  const WorldMetrics now = measure(world);
+  const auto bodies = world.bodies();
+  const Vec3 g = world.settings().gravity;
+  double gravity_work = 0.0, force_work = 0.0, scale = std::max(initial_.kinetic_energy, now.kinetic_energy);
+  for (std::size_t i = 0; i < bodies.size() && i < initial_positions_.size(); ++i) {
+    if (bodies[i].fixed) continue;
+    const Vec3 moved = bodies[i].position - initial_positions_[i];
+    gravity_work += bodies[i].mass * g.dot(moved);
+    force_work += bodies[i].force.dot(moved);
+  }
+  const double load_work = force_work + torque_work_;
+  const double integration = now.kinetic_energy - initial_.kinetic_energy - contact_energy_change_ -
+                             correction_energy_ - gravity_work - load_work;
+  // Rounding: each step's sums round at ~1e-16 of the energies involved; 1e-9 leaves a wide margin.
+  scale = std::max({scale, contact_energy_scale_, std::abs(gravity_work), std::abs(load_work),
+                    std::abs(correction_energy_)});
+  const double rounding = std::max(1e-9, 1e-15 * static_cast<double>(steps_)) * scale;
+  json unexpected = json::array();
+  if (contact_energy_change_ > rounding)
+    unexpected.push_back("contacts gained " + std::to_string(contact_energy_change_) + " J");
+  // Net: a bounded, oscillating integration error (splitting) is not a gain unless it ends as one.
+  const double integration_gain = integration - contact_exchange_;
+  if (integration_gain > rounding)
+    unexpected.push_back("integration gained " + std::to_string(integration_gain) +
+                         " J beyond what contacts took back in the same steps");
+  const double e0 = total_energy(initial_), e1 = total_energy(now);
+  return json{{"initial_j", e0},
+              {"final_j", e1},
+              {"change_j", e1 - e0},
+              {"kinetic_final_j", now.kinetic_energy},
+              {"dissipated_by_contacts_j", 0.0 - contact_energy_change_},
+              {"position_correction_j", correction_energy_},
+              {"gravity_work_j", gravity_work},
+              {"applied_load_work_j", load_work},
+              {"integration_j", integration},
+              {"drift_j", integration},
+              {"integration_gain_j", integration_gain},
+              {"contact_exchange_j", contact_exchange_},
+              {"unexpected", unexpected}};
+}
+
+// Δp = gravity + applied loads + impulses from fixed bodies + drift; the same for L about the origin.
+json RunStats::momentum_summary(const World& world) const {
+  const WorldMetrics now = measure(world);
+  const Vec3 dp = now.linear_momentum - initial_.linear_momentum;
+  const Vec3 dl = now.angular_momentum - initial_.angular_momentum;
+  const Vec3 linear_drift = dp - gravity_impulse_ - load_impulse_ - fixed_impulse_;
+  const Vec3 angular_drift = dl - gravity_moment_ - load_moment_ - fixed_moment_;
+  return json{{"linear_change_kg_m_per_s", vec(dp)},
+              {"angular_change_kg_m2_per_s", vec(dl)},
+              {"gravity_impulse_n_s", vec(gravity_impulse_)},
+              {"gravity_moment_n_m_s", vec(gravity_moment_)},
+              {"applied_load_impulse_n_s", vec(load_impulse_)},
+              {"applied_load_moment_n_m_s", vec(load_moment_)},
+              {"fixed_body_impulse_n_s", vec(fixed_impulse_)},
+              {"fixed_body_moment_n_m_s", vec(fixed_moment_)},
+              {"linear_drift_kg_m_per_s", vec(linear_drift)},
+              {"angular_drift_kg_m2_per_s", vec(angular_drift)}};
 }
 
 json RunStats::summary(const World& world, double wall_seconds) const {
-  const WorldMetrics now = measure(world);
-  const double e0 = total_energy(initial_), e1 = total_energy(now);
   const double steps = static_cast<double>(std::max<std::uint64_t>(steps_, 1));
+  const json momentum = momentum_summary(world);
+  const auto norm = [&momentum](const char* key) {
+    const auto& v = momentum[key];
+    return Vec3(v[0].get<double>(), v[1].get<double>(), v[2].get<double>()).norm();
+  };
   return json{
       {"steps", steps_},
       {"bodies", world.bodies().size()},
@@ -83,28 +196,72 @@ json RunStats::summary(const World& world, double wall_seconds) const {
         {"max_rounds_per_step", max_rounds_},
         {"non_converged", non_converged_},
         {"singular_systems", singular_},
+        {"redundant_systems", redundant_},
         {"pulling_impulses", pulling_},
         {"energy_gain_events", energy_gains_},
         {"max_residual_m_per_s", max_residual_},
         {"max_natural_map_residual", max_natural_map_}}},
       {"friction",
        {{"sticking_contacts", sticking_}, {"sliding_contacts", sliding_},
-        {"dissipated_j", -friction_work_}}},
-      {"energy",
-       {{"initial_j", e0}, {"final_j", e1}, {"drift_j", e1 - e0},
-        {"kinetic_final_j", now.kinetic_energy}}},
-      // Momentum drift: the change not explained by gravity (contacts with fixed bodies also count).
-      {"linear_momentum_drift", (now.linear_momentum - initial_.linear_momentum - gravity_impulse_).norm()},
-      {"angular_momentum_drift", (now.angular_momentum - initial_.angular_momentum - gravity_moment_).norm()},
+        {"dissipated_j", 0.0 - friction_work_}}},
+      {"energy", energy_summary(world)},
+      {"momentum", momentum},
+      // The change gravity, applied loads and fixed bodies' impulses do not explain (README.md).
+      {"linear_momentum_drift", norm("linear_drift_kg_m_per_s")},
+      {"angular_momentum_drift", norm("angular_drift_kg_m2_per_s")},
       {"max_penetration_m", max_penetration_},
   };
 }
 
+namespace {
+
+// "ledas (mode: paper)": the plugin and the options the scene or command line gave it.
+std::string module_label(const json& summary, const char* kind) {
+  std::string label = summary["modules"][kind].get<std::string>();
+  const json options = summary.value("module_options", json::object()).value(kind, json::object());
+  if (options.empty()) return label;
+  label += " (";
+  bool first = true;
+  for (const auto& [key, value] : options.items()) {
+    label += (first ? "" : ", ") + key + ": " + (value.is_string() ? value.get<std::string>() : value.dump());
+    first = false;
+  }
+  return label + ")";
+}
+
+void print_energy(const json& e, std::ostream& out) {
+  out << "energy                " << e["initial_j"].get<double>() << " J -> " << e["final_j"].get<double>()
+      << " J: " << 0.0 + e["dissipated_by_contacts_j"].get<double>() << " J dissipated by contacts, "
+      << e["gravity_work_j"].get<double>() << " J work of gravity";
+  if (e["applied_load_work_j"].get<double>() != 0.0)
+    out << ", " << e["applied_load_work_j"].get<double>() << " J work of applied loads";
+  if (e["position_correction_j"].get<double>() != 0.0)
+    out << ", " << e["position_correction_j"].get<double>() << " J from position correction";
+  const double integration = e["integration_j"].get<double>();
+  out << ", " << std::abs(integration) << " J " << (integration > 0.0 ? "gained" : "lost") << " by integration";
+  // A gain the contacts took back within the same steps is the split step's exchange (README.md).
+  if (integration > 0.0 && e["contact_exchange_j"].get<double>() > 0.0 && e["unexpected"].empty())
+    out << " (taken back by contacts in the same steps)";
+  out << "\n";
+  for (const auto& what : e["unexpected"]) out << "  unexpected:         " << what.get<std::string>() << "\n";
+}
+
+}  // namespace
+
 void print_summary(const json& s, std::ostream& out) {
   const auto& t = s["module_time_s"];
   const auto& r = s["resolver"];
-  const auto& e = s["energy"];
+  const auto& m = s["momentum"];
+  const auto norm = [&m](const char* key) {
+    const auto& v = m[key];
+    return Vec3(v[0].get<double>(), v[1].get<double>(), v[2].get<double>()).norm();
+  };
   out << std::setprecision(6);
+  if (s.contains("scene")) out << "scene                 " << s["scene"].get<std::string>() << "\n";
+  if (s.contains("modules")) {
+    out << "modules               integrator " << module_label(s, "integrator") << ", detector "
+        << module_label(s, "detector") << ", resolver " << module_label(s, "resolver") << "\n";
+  }
   out << "steps                 " << s["steps"].get<std::uint64_t>() << " (" << s["bodies"].get<std::size_t>()
       << " bodies)\n"
       << "simulated time        " << s["simulated_time_s"].get<double>() << " s\n"
@@ -113,20 +270,24 @@ void print_summary(const json& s, std::ostream& out) {
       << "time per module       integrate " << t["integrate_velocities"].get<double>() + t["integrate_positions"].get<double>()
       << " s, detect " << t["detect"].get<double>() << " s, resolve " << t["resolve"].get<double>() << " s\n"
       << "contacts per step     mean " << s["contacts_per_step"]["mean"].get<double>() << ", max "
-      << s["contacts_per_step"]["max"].get<std::uint64_t>() << "\n"
+      << s["contacts_per_step"]["max"].get<std::uint64_t>();
+  if (!s["contacts_per_step"].value("resolved", true)) out << " (detected, not resolved: resolver none)";
+  out << "\n"
       << "resolver              " << r["rounds"].get<std::uint64_t>() << " rounds (max "
       << r["max_rounds_per_step"].get<std::uint64_t>() << " per step), " << r["non_converged"].get<std::uint64_t>()
-      << " non-converged, " << r["singular_systems"].get<std::uint64_t>() << " singular, "
+      << " non-converged, " << r["singular_systems"].get<std::uint64_t>() << " singular (failed), "
+      << r["redundant_systems"].get<std::uint64_t>() << " redundant contact sets (minimum-norm), "
       << r["energy_gain_events"].get<std::uint64_t>() << " energy gains, max residual "
       << r["max_residual_m_per_s"].get<double>() << " m/s\n"
       << "friction              " << s["friction"]["sticking_contacts"].get<std::uint64_t>() << " sticking and "
       << s["friction"]["sliding_contacts"].get<std::uint64_t>() << " sliding contacts (summed over steps), "
       << s["friction"]["dissipated_j"].get<double>() << " J dissipated, max natural-map residual "
-      << r["max_natural_map_residual"].get<double>() << "\n"
-      << "energy                " << e["initial_j"].get<double>() << " J -> " << e["final_j"].get<double>()
-      << " J (drift " << e["drift_j"].get<double>() << " J)\n"
-      << "momentum drift        linear " << s["linear_momentum_drift"].get<double>() << " kg m/s, angular "
-      << s["angular_momentum_drift"].get<double>() << " kg m^2/s (beyond gravity; contacts with fixed bodies count too)\n"
+      << r["max_natural_map_residual"].get<double>() << "\n";
+  print_energy(s["energy"], out);
+  out << "momentum              from fixed bodies: linear " << norm("fixed_body_impulse_n_s") << " N s, angular "
+      << norm("fixed_body_moment_n_m_s") << " N m s; drift (unexplained): linear "
+      << s["linear_momentum_drift"].get<double>() << " kg m/s, angular " << s["angular_momentum_drift"].get<double>()
+      << " kg m^2/s\n"
       << "max penetration       " << s["max_penetration_m"].get<double>() << " m\n";
 }
 
@@ -180,6 +341,7 @@ json resolve_report(const World& world, const std::string& resolver, double seco
               {"residual", s.resolver.residual},
               {"pulling_impulses", s.resolver.pulling_impulses},
               {"singular_systems", s.resolver.singular_systems},
+              {"redundant_systems", s.resolver.redundant_systems},
               {"energy_gain_events", s.resolver.energy_gain_events},
               {"natural_map_residual", s.resolver.natural_map_residual},
               {"sticking", s.resolver.sticking},

@@ -12,16 +12,22 @@
 #include <filesystem>
 #include <fstream>
 #include <string>
+#include <vector>
 
 namespace impetus::cli {
 
-/// Statistics gathered over a run, step by step.
+/// Statistics gathered over a run, step by step, for the run summary (README.md, "The run summary").
+///
+/// Energy is accounted, not just compared: ΔKE = (work of contacts) + (work of gravity) + (work of applied
+/// loads) + (what integration gained or lost). Contacts are measured around the resolve stage of each
+/// step (StepStatus::resolve_energy_change); gravity and loads from the positions; integration is the
+/// remainder. Momentum likewise: Δp = gravity + loads + impulses received from fixed bodies + drift.
 class RunStats {
  public:
   explicit RunStats(const World& world);
-  /// Call before world.step(): adds the momentum gravity will add over the step. With velocities
-  /// updated before positions, a free body's angular momentum about the origin changes by exactly
-  /// dt · x_before × m g, so the pre-step position is the one to use.
+  /// Call before world.step(): adds the momentum gravity and the applied loads will add over the step.
+  /// With velocities updated before positions, a free body's angular momentum about the origin changes
+  /// by exactly dt · x_before × (m g + F) + dt τ, so the pre-step position is the one to use.
   void before_step(const World& world);
   /// Adds the step just taken (after world.step()).
   void add_step(const World& world, const StepStatus& status);
@@ -29,13 +35,31 @@ class RunStats {
   nlohmann::json summary(const World& world, double wall_seconds) const;
 
  private:
+  void add_fixed_body_impulses(const World& world);
+  void add_integration_step(const World& world, const StepStatus& status, double torque_work);
+  nlohmann::json energy_summary(const World& world) const;
+  nlohmann::json momentum_summary(const World& world) const;
+
   WorldMetrics initial_;
+  std::vector<Vec3> initial_positions_;  // of every body, for the work of gravity and constant forces
   double total_mass_ = 0.0;
   Vec3 gravity_impulse_ = Vec3::Zero();  // ∫ Σ m g dt: the linear momentum gravity adds
   Vec3 gravity_moment_ = Vec3::Zero();   // ∫ Σ x × m g dt: the angular momentum gravity adds about 0
+  Vec3 load_impulse_ = Vec3::Zero();     // ∫ Σ F dt: the linear momentum applied forces add
+  Vec3 load_moment_ = Vec3::Zero();      // ∫ Σ (x × F + τ) dt
+  Vec3 fixed_impulse_ = Vec3::Zero();    // Σ impulses movable bodies received from fixed ones (N s)
+  Vec3 fixed_moment_ = Vec3::Zero();     // Σ point × impulse of the same, about the origin (N m s)
+  double contact_energy_change_ = 0.0;   // Σ kinetic energy change across the resolve stage (J)
+  double contact_energy_scale_ = 0.0;    // Σ |that change|: the scale rounding is measured against
+  double correction_energy_ = 0.0;       // Σ potential energy the resolver's position correction added (J)
+  double torque_work_ = 0.0;             // Σ dt τ·ω (J)
+  // Σ over steps of the integration gain the same step's contacts took back: the split step gives a
+  // resting (or landing) body gravity's kick before the contact removes it, an exchange, not a gain.
+  double contact_exchange_ = 0.0;
+  double step_kinetic_ = 0.0, step_potential_ = 0.0;  // KE and −Σ (m g + F)·x before the current step
   StepProfile time_;                     // summed over steps
   std::uint64_t steps_ = 0, contacts_ = 0, max_contacts_ = 0, rounds_ = 0, max_rounds_ = 0;
-  std::uint64_t non_converged_ = 0, singular_ = 0, pulling_ = 0, energy_gains_ = 0;
+  std::uint64_t non_converged_ = 0, singular_ = 0, redundant_ = 0, pulling_ = 0, energy_gains_ = 0;
   std::uint64_t sticking_ = 0, sliding_ = 0;
   double friction_work_ = 0.0, max_natural_map_ = 0.0;
   double max_penetration_ = 0.0, max_residual_ = 0.0;

@@ -206,6 +206,7 @@ Vector ComplementaritySolver::solve(const ComplementarityProblem& problem, Solve
   const double scale = work_.diagonal.maxCoeff();
   if (!(scale > 0.0) || !std::isfinite(scale)) {  // nothing movable behind any row
     ++stats.singular;
+    if (!std::isfinite(scale) || problem.rhs.lpNorm<Eigen::Infinity>() > 0.0) ++stats.inconsistent;
     return p;
   }
   if (m == 1) {  // closed form: p = c / A_11, clamped at 0 for a contact (identical to the paper mode's)
@@ -224,7 +225,12 @@ Vector ComplementaritySolver::solve(const ComplementarityProblem& problem, Solve
   for (std::uint64_t iteration = 0; iteration < settings_.max_iterations && !search.done(); ++iteration)
     iterate(search, iteration, stats);
   checkin_masked(std::move(search.loop.factor));
-  if (search.loop.singular) ++stats.singular;
+  // Redundant rows met in the search: solved (a redundant contact set) when the search converged; when
+  // it stalled the minimum-norm fallback below counts its own systems; hitting the cap is a failure.
+  if (search.loop.singular) {
+    ++stats.singular;
+    if (search.outcome != Search::Outcome::converged && search.outcome != Search::Outcome::stalled) ++stats.inconsistent;
+  }
   if (search.outcome == Search::Outcome::stalled) return solve_min_norm(problem, stats);
   if (search.outcome == Search::Outcome::running) ++stats.non_converged;
   if (search.outcome != Search::Outcome::converged)  // the last iterate may be infeasible

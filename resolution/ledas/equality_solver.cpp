@@ -14,6 +14,20 @@ namespace impetus::ledas {
 namespace {
 // Factorizations kept for reuse of their symbolic analysis (distinct sparsity patterns).
 constexpr std::size_t kCacheCapacity = 16;
+
+// A rank-deficient system is counted in `singular`; it is a real failure (`inconsistent`) only when the
+// returned impulses do not satisfy it. Redundant contacts (a box on four corners) give a consistent
+// system: the minimum-norm split meets every target, and nothing failed.
+void count_singular(bool failed, SolverStats& stats) {
+  ++stats.singular;
+  if (failed) ++stats.inconsistent;
+}
+
+// Whether A p = c holds to well above the rank tolerance's rounding (relative to the targets), i.e. the
+// targets were consistent and the minimum-norm solution met them.
+bool satisfies(const Vector& ap, const Vector& c) {
+  return (ap - c).lpNorm<Eigen::Infinity>() <= 1e-6 * c.lpNorm<Eigen::Infinity>();
+}
 }  // namespace
 
 /// A sparse LDLᵀ (Eigen SimplicialLDLT, AMD ordering) with the pattern its symbolic analysis is for.
@@ -70,7 +84,7 @@ bool EqualitySolver::solve_uncoupled(const SparseMatrix& a, const Vector& c, std
     if (a11 > 0.0 && std::isfinite(a11)) {
       p(k) = c(k) / a11;
     } else {
-      ++stats.singular;
+      count_singular(c(k) != 0.0, stats);
       p(k) = 0.0;
     }
     w.parent[static_cast<std::size_t>(i)] = -1;
@@ -135,7 +149,7 @@ Vector EqualitySolver::solve_system(const SparseMatrix& m, const Vector& rhs, So
   if (n == 0) return Vector();
   const double scale = Vector(m.diagonal()).maxCoeff();
   if (!(scale > 0.0) || !std::isfinite(scale)) {  // no movable body behind any row: nothing can change
-    ++stats.singular;
+    count_singular(!std::isfinite(scale) || rhs.lpNorm<Eigen::Infinity>() > 0.0, stats);
     return Vector::Zero(n);
   }
   const double pivot_floor = settings_.rank_tolerance * scale;
@@ -143,7 +157,7 @@ Vector EqualitySolver::solve_system(const SparseMatrix& m, const Vector& rhs, So
     ++stats.closed_form;
     const double a11 = m.coeff(0, 0);
     if (a11 > pivot_floor) return Vector::Constant(1, rhs(0) / a11);
-    ++stats.singular;
+    count_singular(rhs(0) != 0.0, stats);
     return Vector::Zero(1);
   }
   if (static_cast<std::size_t>(n) <= settings_.dense_limit) return solve_dense_matrix(Eigen::MatrixXd(m), rhs, stats);
@@ -154,20 +168,21 @@ Vector EqualitySolver::solve_dense_matrix(const Eigen::MatrixXd& a, const Vector
   ++stats.dense;
   const double scale = a.diagonal().maxCoeff();
   if (!(scale > 0.0) || !std::isfinite(scale)) {  // no movable body behind any row
-    ++stats.singular;
+    count_singular(!std::isfinite(scale) || rhs.lpNorm<Eigen::Infinity>() > 0.0, stats);
     return Vector::Zero(a.rows());
   }
   const double pivot_floor = settings_.rank_tolerance * scale;
   // LDLᵀ with diagonal pivoting reveals the rank of a PSD matrix: a dependent row leaves a ~0 pivot.
   const Eigen::LDLT<Eigen::MatrixXd> ldlt(a);
   if (ldlt.info() == Eigen::Success && (ldlt.vectorD().array() > pivot_floor).all()) return ldlt.solve(rhs);
-  ++stats.singular;
   // Minimum-norm least squares through the eigen-decomposition (the SVD of a symmetric PSD matrix).
   const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eigen(a);
   const Vector& lambda = eigen.eigenvalues();
   Vector y = eigen.eigenvectors().transpose() * rhs;
   for (Eigen::Index i = 0; i < y.size(); ++i) y(i) = lambda(i) > pivot_floor ? y(i) / lambda(i) : 0.0;
-  return eigen.eigenvectors() * y;
+  Vector p = eigen.eigenvectors() * y;
+  count_singular(!satisfies(a * p, rhs), stats);
+  return p;
 }
 
 namespace {
@@ -191,7 +206,6 @@ Vector EqualitySolver::solve_sparse(const SparseMatrix& m, const Vector& rhs, do
     checkin(f);
     return p;
   }
-  ++stats.singular;
   // Minimum norm: A + εI (ε = the pivot floor) is positive definite and shares A's eigenvectors.
   // Shifted inverse iteration converges to the null space of A (eigenvalues ≤ the floor); projecting
   // it out of the right-hand side and of every correction leaves p in the range of A, i.e. A⁺ c.
@@ -231,6 +245,7 @@ Vector EqualitySolver::solve_sparse(const SparseMatrix& m, const Vector& rhs, do
     if (dp.norm() <= 1e-16 * p.norm()) break;
   }
   checkin(f);
+  count_singular(!satisfies(m * p, rhs), stats);
   return p;
 }
 

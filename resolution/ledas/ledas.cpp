@@ -94,7 +94,12 @@ void LedasResolver::resolve(std::span<RigidBody> bodies, std::span<Contact> cont
   counters.non_converged += stats_.velocity.non_converged + stats_.velocity.infeasible + stats_.position.non_converged +
                             stats_.friction.non_converged;
   counters.natural_map_residual = std::max(counters.natural_map_residual, stats_.friction.residual);
-  counters.singular_systems += stats_.velocity.singular + stats_.position.singular;
+  // Rank-deficient systems the minimum-norm impulses satisfied are redundant contact sets (normal);
+  // only those they did not satisfy are singular (a failure).
+  const std::uint64_t rank_deficient = stats_.velocity.singular + stats_.position.singular;
+  const std::uint64_t failed = stats_.velocity.inconsistent + stats_.position.inconsistent;
+  counters.singular_systems += failed;
+  counters.redundant_systems += rank_deficient - failed;
   counters.nan_caught += stats_.velocity.nan_caught + stats_.position.nan_caught + stats_.friction.nan_caught;
 }
 

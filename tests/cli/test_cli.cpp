@@ -9,11 +9,13 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
 #include <string>
+#include <vector>
 
 namespace {
 
@@ -245,6 +247,171 @@ TEST(Cli, FclibRefusesWhatItCannotUse) {
   r = run("fclib export " + chain + " --out " + temp_file("chain.hdf5").string());
   EXPECT_NE(r.status, 0);
   EXPECT_NE(r.out.find("constraints"), std::string::npos) << r.out;
+}
+
+}  // namespace
+
+namespace {
+
+// ---- The run summary (README.md, "The run summary") ----
+
+// One body's rows of a trajectory CSV: position z and velocity (vx, vy, vz) per recorded step.
+struct Track {
+  std::vector<double> z;
+  std::vector<Eigen::Vector3d> v;
+};
+
+Track read_track(const fs::path& file, const std::string& body) {
+  std::istringstream lines(read(file));
+  std::string line;
+  std::getline(lines, line);  // header
+  Track t;
+  while (std::getline(lines, line)) {
+    std::vector<std::string> cells;
+    std::stringstream row(line);
+    for (std::string cell; std::getline(row, cell, ',');) cells.push_back(cell);
+    if (cells.size() != 16 || cells[2] != body) continue;
+    t.z.push_back(std::stod(cells[5]));
+    t.v.emplace_back(std::stod(cells[10]), std::stod(cells[11]), std::stod(cells[12]));
+  }
+  return t;
+}
+
+Eigen::Vector3d vec3(const nlohmann::json& j) {
+  return Eigen::Vector3d(j[0].get<double>(), j[1].get<double>(), j[2].get<double>());
+}
+
+// A 2 kg ball falls 1 m onto a fixed plane with e = 0. Through the step that stops it, the contacts
+// dissipate exactly ½ m v² of its speed at impact (v = its velocity after that step's gravity), and
+// gravity's work is m g Δh; the balance closes and nothing is flagged. 1e-9 relative.
+TEST(CliSummary, BallDropDissipatesItsImpactEnergyAndGravityDoesMgDh) {
+  const double m = 2.0, g = 9.81, dt = 1e-3;
+  const fs::path csv = temp_file("drop.csv");
+  const Result full = run("run " + scene("drop.yaml") + " --steps 600 --json --overwrite --out " + csv.string());
+  ASSERT_EQ(full.status, 0) << full.out;
+  const Track ball = read_track(csv, "ball");
+  ASSERT_EQ(ball.v.size(), 601u);
+  // The impact step: the first whose velocity is not the free-fall prediction v + g dt.
+  std::size_t impact = 0;
+  for (std::size_t k = 1; k < ball.v.size() && impact == 0; ++k)
+    if (ball.v[k].z() != ball.v[k - 1].z() + dt * -g) impact = k;
+  ASSERT_GT(impact, 400u);
+  const double v_impact = ball.v[impact - 1].z() + dt * -g;
+  EXPECT_LT(std::abs(ball.v[impact].z()), 1e-9 * std::abs(v_impact));  // e = 0: stopped in that step
+
+  const Result upto = run("run " + scene("drop.yaml") + " --steps " + std::to_string(impact) + " --json");
+  ASSERT_EQ(upto.status, 0) << upto.out;
+  const auto e = nlohmann::json::parse(upto.out)["energy"];
+  const double impact_energy = 0.5 * m * v_impact * v_impact;
+  std::printf("drop: impact at step %zu, v = %.9g m/s, 1/2 m v^2 = %.12g J, dissipated %.12g J\n", impact, v_impact,
+              impact_energy, e["dissipated_by_contacts_j"].get<double>());
+  EXPECT_NEAR(e["dissipated_by_contacts_j"].get<double>(), impact_energy, 1e-9 * impact_energy);
+  EXPECT_NEAR(e["gravity_work_j"].get<double>(), m * g * (ball.z[0] - ball.z[impact]), 1e-9 * impact_energy);
+  // The balance closes on the trajectory's kinetic energy; what integration gained (gravity's kick in
+  // the impact step, which the contact took back) is not flagged.
+  const double kinetic_change = 0.5 * m * (ball.v[impact].squaredNorm() - ball.v[0].squaredNorm());
+  EXPECT_NEAR(kinetic_change,
+              -e["dissipated_by_contacts_j"].get<double>() + e["position_correction_j"].get<double>() +
+                  e["gravity_work_j"].get<double>() + e["integration_j"].get<double>(),
+              1e-9 * impact_energy);
+  EXPECT_LT(e["integration_gain_j"].get<double>(), 1e-9 * impact_energy);
+  EXPECT_TRUE(e["unexpected"].empty()) << e.dump();
+
+  // Over the whole run, resting steps included: contacts absorb each step's gravity, and the balance
+  // matches the trajectory step by step.
+  const auto ef = nlohmann::json::parse(full.out)["energy"];
+  double resolve_change = 0.0;
+  for (std::size_t k = 1; k < ball.v.size(); ++k) {
+    const double predicted = ball.v[k - 1].z() + dt * -g;
+    resolve_change += 0.5 * m * (ball.v[k].squaredNorm() - predicted * predicted);
+  }
+  EXPECT_NEAR(ef["dissipated_by_contacts_j"].get<double>(), -resolve_change, 1e-9 * impact_energy);
+  EXPECT_NEAR(ef["gravity_work_j"].get<double>(), m * g * (ball.z.front() - ball.z.back()), 1e-9 * impact_energy);
+  EXPECT_TRUE(ef["unexpected"].empty()) << ef.dump();
+}
+
+// A box sliding down a 30° slope with friction: the impulses it receives from the fixed ground
+// (normal and friction) and gravity explain its momentum change; the drift left is rounding.
+TEST(CliSummary, SlidingBoxMomentumIsExplainedByTheFixedGround) {
+  const Result r = run("run " + scene("slope.yaml") + " --duration 1 --json");
+  ASSERT_EQ(r.status, 0) << r.out;
+  const auto j = nlohmann::json::parse(r.out);
+  const auto& p = j["momentum"];
+  const Eigen::Vector3d change = vec3(p["linear_change_kg_m_per_s"]);
+  const Eigen::Vector3d from_ground = vec3(p["fixed_body_impulse_n_s"]);
+  const Eigen::Vector3d from_gravity = vec3(p["gravity_impulse_n_s"]);
+  std::printf("slope: dp = (%.6g, %.6g, %.6g), ground (%.6g, %.6g, %.6g), drift %.3g kg m/s, angular %.3g\n",
+              change.x(), change.y(), change.z(), from_ground.x(), from_ground.y(), from_ground.z(),
+              j["linear_momentum_drift"].get<double>(), j["angular_momentum_drift"].get<double>());
+  EXPECT_GT(change.x(), 0.5);        // it slides: a ≈ 0.657 m/s² for 1 s
+  EXPECT_GT(from_ground.z(), 8.0);   // the normal impulse carries the weight's normal part, 8.5 N s
+  EXPECT_LT(from_ground.x(), -4.0);  // friction μ N ≈ 4.25 N s up the slope
+  EXPECT_LT((change - from_gravity - from_ground).norm(), 1e-9);
+  EXPECT_LT(j["linear_momentum_drift"].get<double>(), 1e-9);
+  const Result text = run("run " + scene("slope.yaml") + " --duration 1");
+  EXPECT_NE(text.out.find("from fixed bodies: linear"), std::string::npos) << text.out;
+  EXPECT_NE(text.out.find("drift (unexplained)"), std::string::npos) << text.out;
+}
+
+// A box resting flat on four corners: redundant contact sets solved by minimum norm, none singular,
+// and the summary says so in those words.
+TEST(CliSummary, RestingBoxReportsRedundantContactSetsNotSingular) {
+  const Result r = run("run " + scene("resting_box.yaml") + " --steps 120 --json");
+  ASSERT_EQ(r.status, 0) << r.out;
+  const auto j = nlohmann::json::parse(r.out);
+  EXPECT_GT(j["resolver"]["redundant_systems"].get<std::uint64_t>(), 0u) << r.out;
+  EXPECT_EQ(j["resolver"]["singular_systems"].get<std::uint64_t>(), 0u) << r.out;
+  EXPECT_TRUE(j["energy"]["unexpected"].empty()) << r.out;
+  const Result text = run("run " + scene("resting_box.yaml") + " --steps 120");
+  EXPECT_NE(text.out.find("redundant contact sets (minimum-norm)"), std::string::npos) << text.out;
+  EXPECT_NE(text.out.find(" 0 singular (failed)"), std::string::npos) << text.out;
+}
+
+// The summary names the resolver with the options the scene or --set gave it.
+TEST(CliSummary, ShowsTheResolverAndItsOptions) {
+  const std::string args = "run " + scene("resting_box.yaml") + " --steps 5 --set modules.resolver.mode=paper";
+  const Result text = run(args);
+  ASSERT_EQ(text.status, 0) << text.out;
+  EXPECT_NE(text.out.find("resolver ledas (mode: paper)"), std::string::npos) << text.out;
+  const auto j = nlohmann::json::parse(run(args + " --json").out);
+  EXPECT_EQ(j["modules"]["resolver"], "ledas");
+  EXPECT_EQ(j["module_options"]["resolver"]["mode"], "paper");
+  const Result plain = run("run " + scene("resting_box.yaml") + " --steps 5");
+  EXPECT_NE(plain.out.find("resolver ledas\n"), std::string::npos) << plain.out;
+}
+
+// `resolver: none` still detects (README.md): the summary says the contacts were not resolved.
+TEST(CliSummary, ResolverNoneSaysContactsWereDetectedNotResolved) {
+  const std::string args = "run " + scene("drop.yaml") + " --steps 600 --resolver none";
+  const Result text = run(args);
+  ASSERT_EQ(text.status, 0) << text.out;
+  EXPECT_NE(text.out.find("detected, not resolved"), std::string::npos) << text.out;
+  const auto j = nlohmann::json::parse(run(args + " --json").out);
+  EXPECT_FALSE(j["contacts_per_step"]["resolved"].get<bool>());
+  EXPECT_GT(j["contacts_per_step"]["max"].get<std::uint64_t>(), 0u);
+  EXPECT_EQ(j["energy"]["dissipated_by_contacts_j"].get<double>(), 0.0);
+}
+
+// Integration that gains energy on a free body is flagged: the `momentum` integrator lets a tumbling
+// box's kinetic energy grow at first order in dt (README.md); `splitting` bounds it and is not flagged.
+TEST(CliSummary, IntegrationGainIsFlaggedOnlyWhenItIsOne) {
+  const Result momentum = run("run " + scene("spin.yaml") + " --duration 2");
+  EXPECT_NE(momentum.out.find("unexpected:         integration gained"), std::string::npos) << momentum.out;
+  const auto jm = nlohmann::json::parse(run("run " + scene("spin.yaml") + " --duration 2 --json").out);
+  EXPECT_GT(jm["energy"]["integration_gain_j"].get<double>(), 0.1);
+  EXPECT_EQ(jm["energy"]["unexpected"].size(), 1u);
+  const auto js =
+      nlohmann::json::parse(run("run " + scene("spin.yaml") + " --duration 2 --json --integrator splitting").out);
+  EXPECT_TRUE(js["energy"]["unexpected"].empty()) << js["energy"].dump();
+  // Without contacts or gravity the whole change is integration's: drift_j keeps its old value.
+  EXPECT_DOUBLE_EQ(jm["energy"]["drift_j"].get<double>(), jm["energy"]["change_j"].get<double>());
+}
+
+TEST(CliSummary, RunHelpExplainsTheTerms) {
+  const Result r = run("run --help");
+  EXPECT_EQ(r.status, 0);
+  EXPECT_NE(r.out.find("redundant contact sets (minimum-norm)"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("singular (failed)"), std::string::npos) << r.out;
 }
 
 }  // namespace

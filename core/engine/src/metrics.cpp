@@ -11,6 +11,21 @@ WorldMetrics measure(const World& world) {
   return m;
 }
 
+double total_kinetic_energy(std::span<const RigidBody> bodies) {
+  double energy = 0.0;
+  for (const RigidBody& b : bodies)
+    if (!b.fixed)
+      energy += 0.5 * b.mass * b.velocity.squaredNorm() + 0.5 * b.angular_velocity.dot(b.inertia_world() * b.angular_velocity);
+  return energy;
+}
+
+double load_potential_energy(std::span<const RigidBody> bodies, const Vec3& g) {
+  double energy = 0.0;
+  for (const RigidBody& b : bodies)
+    if (!b.fixed) energy -= (b.mass * g + b.force).dot(b.position);
+  return energy;
+}
+
 WorldMetrics measure_bodies(std::span<const RigidBody> bodies, const Vec3& g) {
   WorldMetrics m;
   for (const RigidBody& b : bodies) {

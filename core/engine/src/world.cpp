@@ -1,6 +1,7 @@
 #include "impetus/engine/world.hpp"
 
 #include "impetus/core/error.hpp"
+#include "impetus/engine/metrics.hpp"
 
 #include <algorithm>
 #include <chrono>
@@ -158,8 +159,14 @@ void World::detect(StepStatus& status) {
 
 void World::resolve(StepStatus& status) {
   const auto start = Clock::now();
-  if (resolver_ && (!contacts_.empty() || !constraints_.empty()))
+  if (resolver_ && (!contacts_.empty() || !constraints_.empty())) {
+    // Measured around the resolver so that a run can tell energy lost in impacts from energy the
+    // integrator gains or loses (the run summary's energy balance).
+    const double kinetic = total_kinetic_energy(bodies_), potential = load_potential_energy(bodies_, settings_.gravity);
     resolver_->resolve(bodies_, contacts_, constraints_, context(), status.resolver);
+    status.resolve_kinetic_energy_change = total_kinetic_energy(bodies_) - kinetic;
+    status.resolve_potential_energy_change = load_potential_energy(bodies_, settings_.gravity) - potential;
+  }
   status.profile.resolve = seconds_since(start);
 }
 

@@ -38,7 +38,13 @@ struct ResolverCounters {
   std::uint64_t rounds = 0;            ///< solve rounds (simultaneous) or single impulses (sequential)
   std::uint64_t pulling_impulses = 0;  ///< impulses that came out negative (would pull bodies together)
   std::uint64_t non_converged = 0;     ///< systems that hit the iteration cap
-  std::uint64_t singular_systems = 0;  ///< systems found rank-deficient (minimum-norm solution used)
+  /// Systems the resolver could not solve: rank-deficient with conflicting targets (the minimum-norm
+  /// solution leaves a residual), or no movable body behind any row. A real failure.
+  std::uint64_t singular_systems = 0;
+  /// Redundant contact sets solved exactly by the minimum-norm impulses: more rows than the bodies have
+  /// degrees of freedom (a box resting on four corners), so the split among the rows is not unique and
+  /// the smallest one is taken. Normal, not a failure (README.md, "The run summary").
+  std::uint64_t redundant_systems = 0;
   std::uint64_t nan_caught = 0;        ///< non-finite results rejected
   double residual = 0.0;               ///< largest approach velocity left after resolving (m/s, ≥ 0)
   double complementarity_error = 0.0;  ///< largest |p · v_n⁺| over the contacts (N·m/s)

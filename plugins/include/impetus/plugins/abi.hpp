@@ -25,7 +25,9 @@ class ModuleOptions;
 /// 2: the descriptor carries the layout words. 3: friction (CollisionResolver::accept_friction, the
 /// contact's tangential impulse and mode, the resolver's friction counters). 4: local contact problems
 /// (CollisionResolver::solve_contact_problem, LocalContactProblem, LocalContactSolution).
-inline constexpr std::uint32_t kPluginAbiVersion = 4;
+/// 5: ResolverCounters::redundant_systems (redundant contact sets solved by minimum norm, told apart from
+/// singular_systems, which now counts only real failures).
+inline constexpr std::uint32_t kPluginAbiVersion = 5;
 
 /// Name of the entry symbol every plugin exports.
 inline constexpr const char* kPluginEntrySymbol = "impetus_plugin_descriptor";

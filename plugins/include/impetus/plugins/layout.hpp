@@ -101,7 +101,7 @@ inline LayoutWords plugin_layout_words() {
   using RC = ResolverCounters;
   at(LayoutType::resolver_counters) =
       layout_word<RC>(&RC::islands, &RC::contacts, &RC::rounds, &RC::pulling_impulses, &RC::non_converged,
-                      &RC::singular_systems, &RC::nan_caught, &RC::residual, &RC::complementarity_error,
+                      &RC::singular_systems, &RC::redundant_systems, &RC::nan_caught, &RC::residual, &RC::complementarity_error,
                       &RC::energy_gain_events, &RC::sticking, &RC::sliding, &RC::natural_map_residual,
                       &RC::friction_work);
   at(LayoutType::module_status) = layout_word<ModuleStatus>(&ModuleStatus::ok, &ModuleStatus::message);

@@ -24,6 +24,13 @@ WorldMetrics measure(const World& world);
 /// contact fields stay zero.
 WorldMetrics measure_bodies(std::span<const RigidBody> bodies, const Vec3& gravity = Vec3(0.0, 0.0, -9.81));
 
+/// Kinetic energy Σ ½ m v² + ½ ωᵀ J_world ω of the movable bodies (J).
+double total_kinetic_energy(std::span<const RigidBody> bodies);
+
+/// Potential energy of gravity and the (constant) applied forces, −Σ (m g + F)·x over the movable bodies
+/// (J), zero at the origin.
+double load_potential_energy(std::span<const RigidBody> bodies, const Vec3& gravity);
+
 /// Total energy: kinetic + potential.
 inline double total_energy(const WorldMetrics& m) { return m.kinetic_energy + m.potential_energy; }
 

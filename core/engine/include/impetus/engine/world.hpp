@@ -50,6 +50,13 @@ struct StepStatus {
   IntegratorCounters integrator;
   DetectorCounters detector;
   ResolverCounters resolver;
+  /// Kinetic energy of the movable bodies after the resolve stage minus before it (J): the work of the
+  /// contact and constraint impulses, < 0 when they dissipate. 0 when nothing was resolved.
+  double resolve_kinetic_energy_change = 0.0;
+  /// Potential energy of gravity and the applied forces, −Σ (m g + F)·x over the movable bodies, after
+  /// the resolve stage minus before it (J): what a resolver's position correction (moving bodies out of
+  /// penetration) adds. 0 when nothing was resolved or positions were not corrected.
+  double resolve_potential_energy_change = 0.0;
   std::uint64_t nan_caught = 0;  ///< bodies whose state became non-finite (restored to before the step)
   bool ok = true;                ///< false when anything non-finite was caught
   std::string message;           ///< why not ok, naming the body and the stage

@@ -78,6 +78,10 @@ struct SolverStats {
   std::uint64_t sparse = 0;       ///< sparse LDLᵀ factorizations
   std::uint64_t updated = 0;      ///< systems solved by a Schur-complement update (no refactoring)
   std::uint64_t singular = 0;     ///< rank-deficient systems (minimum-norm solution returned)
+  /// Of `singular`, the systems the minimum-norm solution does not satisfy (conflicting targets, or a
+  /// non-zero target with nothing movable behind it): real failures. The rest are redundant contact sets
+  /// solved exactly (ResolverCounters::redundant_systems).
+  std::uint64_t inconsistent = 0;
   std::uint64_t symbolic_analyses = 0;  ///< sparse symbolic analyses computed
   std::uint64_t symbolic_reused = 0;    ///< sparse factorizations that reused a cached analysis
   std::uint64_t iterations = 0;   ///< active-set iterations (one linear solve each)

@@ -119,7 +119,8 @@ struct LedasStats {
 /// Counters: islands; contacts (that entered a system); rounds (linear systems solved in the velocity
 /// phase: rounds in paper mode, active-set iterations in complementary mode); pulling_impulses (paper:
 /// negative impulses applied; complementary: negative impulses released by the active set);
-/// non_converged; singular_systems (minimum-norm solutions); nan_caught (bad contacts, non-finite
+/// non_converged; redundant_systems (rank-deficient systems the minimum-norm solution satisfies);
+/// singular_systems (rank-deficient systems it does not: conflicting targets); nan_caught (bad contacts, non-finite
 /// solutions); residual (largest v_n approach left below the target, m/s); complementarity_error
 /// (max |P·(v_n − target)| after the inelastic phase, P the total inelastic impulse); energy_gain_events
 /// (islands with restitution whose kinetic energy rose, possible only with mixed restitution).
