@@ -36,7 +36,7 @@ class RunStats {
 
  private:
   void add_fixed_body_impulses(const World& world);
-  void add_integration_step(const World& world, const StepStatus& status, double torque_work);
+  void add_integration_step(const World& world, const StepStatus& status, double step_load_work);
   nlohmann::json energy_summary(const World& world) const;
   nlohmann::json momentum_summary(const World& world) const;
 
@@ -52,7 +52,8 @@ class RunStats {
   double contact_energy_change_ = 0.0;   // Σ kinetic energy change across the resolve stage (J)
   double contact_energy_scale_ = 0.0;    // Σ |that change|: the scale rounding is measured against
   double correction_energy_ = 0.0;       // Σ potential energy the resolver's position correction added (J)
-  double torque_work_ = 0.0;             // Σ dt τ·ω (J)
+  double step_load_work_ = 0.0;          // Σ dt (F_body·v + τ·ω) over loads without a potential (J)
+  double prescribed_work_ = 0.0;         // Σ work of moving fixed bodies through contacts (J)
   // Σ over steps of the integration gain the same step's contacts took back: the split step gives a
   // resting (or landing) body gravity's kick before the contact removes it, an exchange, not a gain.
   double contact_exchange_ = 0.0;

@@ -76,7 +76,7 @@ struct FclDetector::Impl {
   std::vector<Body> bodies;
   std::vector<BodyIndex> movable, planes;
   std::vector<std::uint64_t> excluded;  // sorted pair keys
-  std::vector<Aabb> boxes;              // tight world boxes grown by half the margin (fixed: once)
+  std::vector<Aabb> boxes;              // tight world boxes grown by half the margin (at rest: once)
   Broadphase broadphase;
   std::vector<BodyPair> pairs;
   std::vector<ManifoldPoint> points;
@@ -153,9 +153,12 @@ ModuleStatus FclDetector::Impl::add_body(const RigidBody& body, BodyIndex index,
     planes.push_back(index);  // planes never enter a tree: they are tested against the boxes directly
     return ModuleStatus::success();
   }
-  if (!body.fixed) movable.push_back(index);
+  // A fixed body that moves (prescribed motion) has its box refreshed and lives in the movable tree like
+  // a movable body; it still never pairs with another fixed body (filtered()).
+  const bool moves = !body.fixed || body.motion == PrescribedMotion::moving;
+  if (moves) movable.push_back(index);
   boxes[index] = grown(world_aabb(placed(body, index)), 0.5 * settings.margin);
-  broadphase.add(index, bodies.back().fcl, body.fixed, boxes[index]);
+  broadphase.add(index, bodies.back().fcl, !moves, boxes[index]);
   return ModuleStatus::success();
 }
 

@@ -9,10 +9,11 @@ RotationSettings RotationSettings::from_options(const ModuleOptions& options) {
 }
 
 void integrate_velocity(RigidBody& body, const StepContext& ctx) {
-  // eq. (2), row 1: the force acts through the center of mass.
-  body.velocity += ctx.dt * (ctx.gravity + body.inv_mass * body.force);
+  // eq. (2), row 1: the force acts through the center of mass. Body-frame loads are turned into the
+  // world frame at the pose the step starts from.
+  body.velocity += ctx.dt * (ctx.gravity + body.inv_mass * body.applied_force());
   // eq. (2), row 2.
-  body.angular_velocity += ctx.dt * (body.inv_inertia_world() * body.torque);
+  body.angular_velocity += ctx.dt * (body.inv_inertia_world() * body.applied_torque());
 }
 
 void advance_pose(RigidBody& body, double dt, const RotationSettings& settings,

@@ -21,9 +21,9 @@ class MyIntegrator final : public impetus::Integrator {
     const double keep = 1.0 / (1.0 + damping_ * ctx.dt);
     for (impetus::RigidBody& body : bodies) {
       if (body.fixed) continue;
-      body.velocity = keep * (body.velocity + ctx.dt * (ctx.gravity + body.inv_mass * body.force));
+      body.velocity = keep * (body.velocity + ctx.dt * (ctx.gravity + body.inv_mass * body.applied_force()));
       body.angular_velocity =
-          keep * (body.angular_velocity + ctx.dt * (body.inv_inertia_world() * body.torque));
+          keep * (body.angular_velocity + ctx.dt * (body.inv_inertia_world() * body.applied_torque()));
       ++counters.bodies;
     }
   }

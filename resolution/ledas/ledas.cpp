@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <new>
 #include <span>
 #include <string>
 #include <utility>
@@ -101,6 +102,23 @@ void LedasResolver::resolve(std::span<RigidBody> bodies, std::span<Contact> cont
   counters.singular_systems += failed;
   counters.redundant_systems += rank_deficient - failed;
   counters.nan_caught += stats_.velocity.nan_caught + stats_.position.nan_caught + stats_.friction.nan_caught;
+}
+
+void LedasResolver::bodies_removed(std::span<const std::int64_t> new_index) noexcept {
+  // Renumbering keeps a < b (removal preserves order), so the map's order is unchanged.
+  const auto renumbered = [&](BodyIndex i) { return i < new_index.size() ? new_index[i] : std::int64_t{-1}; };
+  try {
+    std::map<ContactKey, ContactImpulse> kept;
+    for (const auto& [key, impulse] : next_warm_) {
+      const std::int64_t a = renumbered(key.a), b = renumbered(key.b);
+      if (a >= 0 && b >= 0)
+        kept.emplace_hint(kept.end(), ContactKey{static_cast<BodyIndex>(a), static_cast<BodyIndex>(b), key.feature},
+                          impulse);
+    }
+    next_warm_.swap(kept);
+  } catch (const std::bad_alloc&) {
+    next_warm_.clear();  // a cold start next step: slower, never wrong
+  }
 }
 
 void LedasResolver::resolve_all(std::span<RigidBody> bodies, std::span<Contact> contacts,

@@ -156,6 +156,21 @@ TEST(SceneErrors, MassOnAFixedBodyIsRefused) {
                "scene.yaml:2:34: 'mass' does not apply to a fixed body");
 }
 
+TEST(SceneErrors, LoadsOnAFixedBodyAndMotionOnAMovableOneAreRefused) {
+  expect_error("bodies:\n  - {name: g, fixed: true, force: [1, 0, 0], shape: {sphere: {radius: 1}}}\n",
+               "scene.yaml:2:35: 'force' does not apply to a fixed body");
+  expect_error("bodies:\n  - {name: g, fixed: true, torque_body: [0, 0, 1], shape: {sphere: {radius: 1}}}\n",
+               "scene.yaml:2:41: 'torque_body' does not apply to a fixed body");
+  expect_error("bodies:\n  - {name: b, mass: 1, motion: moving, shape: {sphere: {radius: 1}}}\n",
+               "scene.yaml:2:32: 'motion' (a prescribed motion) applies to fixed bodies only");
+  expect_error("bodies:\n  - {name: g, fixed: true, motion: surface, shape: {sphere: {radius: 1}}}\n",
+               "scene.yaml:2:36: 'motion' needs the fixed body's 'velocity' or 'angular_velocity'");
+  expect_error("bodies:\n  - {name: g, fixed: true, velocity: [1, 0, 0], motion: belt, shape: {sphere: {radius: 1}}}\n",
+               "scene.yaml:2:57: 'motion' expects one of: moving, surface");
+  expect_error("bodies:\n  - {name: b, mass: 1, force: [1, .nan, 0], shape: {sphere: {radius: 1}}}\n",
+               "scene.yaml:2:");
+}
+
 TEST(SceneErrors, DuplicateBodyNameIsRefused) {
   expect_error(R"(bodies:
   - {name: ball, shape: {sphere: {radius: 1}}, mass: 1}

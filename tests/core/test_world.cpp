@@ -235,5 +235,83 @@ TEST(WorldConstraints, NonCollidingConstraintPairsAreExcludedFromDetection) {
   EXPECT_THROW(world.add_constraint(PointPointConstraint{0, 7}), Error);
 }
 
+// A resolver that records what bodies_removed() told it.
+class RenumberLog : public PlaneContactResolver {
+ public:
+  ModuleStatus accept_constraints(std::span<const Constraint>) noexcept override { return {}; }
+  void bodies_removed(std::span<const std::int64_t> new_index) noexcept override {
+    told.assign(new_index.begin(), new_index.end());
+  }
+  std::vector<std::int64_t> told;
+};
+
+// Removal: later indices shift down, handles stay, the joined constraints go with the body and the others
+// are renumbered, the last contacts are cleared, the resolver gets the renumbering at once and the
+// detector the new bodies before the next detection.
+TEST(WorldBodies, RemovalRenumbersConstraintsAndTellsTheModules) {
+  World world;
+  world.add_body(ground());
+  for (const char* name : {"a", "b", "c", "d"}) world.add_body(sphere(name, 0.5, 1.0, {0, 0, 0.5}));
+  world.add_constraint(PointPointConstraint{1, 2, Vec3::Zero(), Vec3::Zero()});  // a–b: goes with b
+  world.add_constraint(PointPointConstraint{3, 4, Vec3::Zero(), Vec3::Zero()});  // c–d: renumbered
+  world.set_integrator(std::make_shared<LinearIntegrator>());
+  auto detector = std::make_shared<SpherePlaneDetector>();
+  auto resolver = std::make_shared<RenumberLog>();
+  world.set_detector(detector);
+  world.set_resolver(resolver);
+  world.step();
+  ASSERT_EQ(world.contacts().size(), 4u);
+  const BodyHandle b = world.handle(2), d = world.handle(4);
+  EXPECT_EQ(world.remove_body("b"), 1u);
+  EXPECT_EQ(resolver->told, (std::vector<std::int64_t>{0, 1, -1, 2, 3}));
+  EXPECT_TRUE(world.contacts().empty());
+  ASSERT_EQ(world.constraints().size(), 1u);
+  const auto& joint = std::get<PointPointConstraint>(world.constraints()[0]);
+  EXPECT_EQ(joint.a, 2u);
+  EXPECT_EQ(joint.b, 3u);
+  EXPECT_EQ(world.index_of(d), BodyIndex{3});
+  EXPECT_FALSE(world.index_of(b).has_value());
+  world.step();
+  EXPECT_EQ(world.contacts().size(), 3u);  // the detector saw four bodies, not five
+  for (const Contact& c : world.contacts()) EXPECT_LT(c.b, 4u);
+  // Twice is an error, by handle or by name, and says which.
+  try {
+    world.remove_body(b);
+    ADD_FAILURE() << "removing a removed body did not throw";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("(it was removed)"), std::string::npos) << e.what();
+  }
+  EXPECT_THROW(world.remove_body("b"), Error);
+  EXPECT_THROW(world.remove_body(BodyHandle{99}), Error);
+  // New bodies get new handles, never a removed one's.
+  world.add_body(sphere("e", 0.5, 1.0, {0, 0, 0.5}));
+  EXPECT_GT(world.handle(4).value, d.value);
+}
+
+// A fixed body moves exactly with its prescribed velocities (x += dt v, R = Q(ω dt) R each step): after
+// 1000 steps it sits at v t (1e-12) turned by ω t (1e-12); `surface` leaves it in place.
+TEST(WorldBodies, FixedBodiesMoveWithTheirPrescribedMotion) {
+  World world;
+  RigidBody mover = ground();
+  mover.name = "mover";
+  mover.shape = Box{Vec3(1, 1, 1)};
+  mover.motion = PrescribedMotion::moving;
+  mover.velocity = Vec3(0.3, -0.2, 0.1);
+  mover.angular_velocity = Vec3(0.0, 0.0, 0.5);
+  RigidBody belt = mover;
+  belt.name = "belt";
+  belt.motion = PrescribedMotion::surface;
+  world.add_body(mover);
+  world.add_body(belt);
+  world.set_integrator(std::make_shared<LinearIntegrator>());
+  for (int i = 0; i < 1000; ++i) world.step();
+  const RigidBody& moved = world.bodies()[0];
+  EXPECT_LT((moved.position - Vec3(0.3, -0.2, 0.1)).norm(), 1e-12);
+  EXPECT_LT((moved.rotation - Eigen::AngleAxisd(0.5, Vec3::UnitZ()).toRotationMatrix()).norm(), 1e-12);
+  EXPECT_EQ(moved.velocity, mover.velocity);  // never changed by the step
+  EXPECT_EQ(world.bodies()[1].position, Vec3::Zero());
+  EXPECT_EQ(world.bodies()[1].rotation, Mat3::Identity());
+}
+
 }  // namespace
 }  // namespace impetus

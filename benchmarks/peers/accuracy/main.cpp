@@ -109,12 +109,18 @@ RunResult run(const Scenario& scenario, const PeerMethod& method, double dt, con
   }
   // The peers' friction (ODE's pyramid, Bullet's and MuJoCo's cones) is not translated yet: a scene with
   // friction is refused for every engine rather than run without it.
-  for (const RigidBody& b : world->bodies())
-    if (b.material.friction > 0.0) {
+  // Nor are applied loads and prescribed motions.
+  for (const RigidBody& b : world->bodies()) {
+    const char* missing = b.material.friction > 0.0              ? "friction"
+                          : b.loaded()                           ? "an applied load"
+                          : b.motion != PrescribedMotion::none ? "a prescribed motion"
+                                                                 : nullptr;
+    if (missing) {
       result.status = "unsupported";
-      result.message = method.label() + ": body '" + b.name + "' has friction; friction is not translated to the peers yet";
+      result.message = method.label() + ": body '" + b.name + "' has " + missing + ", which is not translated to the peers yet";
       return result;
     }
+  }
   auto stamp = std::make_shared<ImpulseStamp>();
   world->set_resolver(stamp);
   const bool impact = scenario.kind == Kind::impact;

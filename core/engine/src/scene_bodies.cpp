@@ -1,4 +1,5 @@
-// `bodies:` entries: name, shape, mass properties, pose, velocities, material, collision filter.
+// `bodies:` entries: name, shape, mass properties, pose, velocities, material, collision filter, applied
+// loads (movable bodies) and prescribed motion (fixed bodies).
 
 #include "impetus/assets/mesh_body.hpp"
 #include "impetus/core/mass.hpp"
@@ -143,7 +144,8 @@ std::string context_name(const YAML::Node& node, std::size_t index) {
 ReadBody read_body(const SceneReader& r, const YAML::Node& node, std::size_t index) {
   const Fields f(r, node, context_name(node, index),
                  {"name", "fixed", "shape", "mass", "density", "inertia", "position", "orientation", "velocity",
-                  "angular_velocity", "restitution", "friction", "collision_group", "collision_mask"});
+                  "angular_velocity", "restitution", "friction", "collision_group", "collision_mask", "force",
+                  "torque", "force_body", "torque_body", "motion"});
   ReadBody out;
   RigidBody& body = out.body;
   out.where = f.require("name");
@@ -165,17 +167,38 @@ ReadBody read_body(const SceneReader& r, const YAML::Node& node, std::size_t ind
   if (const YAML::Node* n = f.find("collision_mask"))
     body.collision_mask = static_cast<std::uint32_t>(r.integer(*n, "collision_mask", 0, kMaxBits));
 
+  if (const YAML::Node* n = f.find("force")) body.force = r.vec3(*n, "force");
+  if (const YAML::Node* n = f.find("torque")) body.torque = r.vec3(*n, "torque");
+  if (const YAML::Node* n = f.find("force_body")) body.force_body = r.vec3(*n, "force_body");
+  if (const YAML::Node* n = f.find("torque_body")) body.torque_body = r.vec3(*n, "torque_body");
+
   const YAML::Node* mass = f.find("mass");
   const YAML::Node* density = f.find("density");
   const YAML::Node* inertia = f.find("inertia");
+  const YAML::Node* motion = f.find("motion");
   if (fixed) {
-    // A fixed body's mass is infinite and it never moves: these keys would be silently ignored.
-    for (const char* key : {"mass", "density", "inertia", "velocity", "angular_velocity"})
+    // A fixed body's mass is infinite: these keys would be silently ignored.
+    for (const char* key : {"mass", "density", "inertia"})
       if (const YAML::Node* n = f.find(key))
-        r.fail(*n, "'" + std::string(key) + "' does not apply to a fixed body (infinite mass, never moves)");
+        r.fail(*n, "'" + std::string(key) + "' does not apply to a fixed body (infinite mass)");
+    for (const char* key : {"force", "torque", "force_body", "torque_body"})
+      if (const YAML::Node* n = f.find(key))
+        r.fail(*n, "'" + std::string(key) + "' does not apply to a fixed body (infinite mass: a load would do "
+                   "nothing); give it 'velocity' or 'angular_velocity' to move it");
+    // Velocities on a fixed body are its prescribed motion: it moves with them, or with `motion:
+    // surface` stays in place while its surface moves (a conveyor belt).
+    const bool has_velocity = f.find("velocity") || f.find("angular_velocity");
+    if (motion && !has_velocity)
+      r.fail(*motion, "'motion' needs the fixed body's 'velocity' or 'angular_velocity'");
+    if (has_velocity)
+      body.motion = !motion || r.choice(*motion, "motion", {"moving", "surface"}) == "moving" ? PrescribedMotion::moving
+                                                                                             : PrescribedMotion::surface;
     make_fixed(body);
     return out;
   }
+  if (motion)
+    r.fail(*motion, "'motion' (a prescribed motion) applies to fixed bodies only; this body moves under forces "
+                    "and contacts");
   if (std::holds_alternative<Plane>(body.shape))
     r.fail(shape_node, "a plane is only allowed on a fixed body; add 'fixed: true' to " + f.context());
   if (mass && density) r.fail(*density, "give either 'mass' or 'density', not both");

@@ -27,6 +27,21 @@ std::string body_label(const RigidBody& body, std::size_t index) {
   return "body '" + (body.name.empty() ? "#" + std::to_string(index) : body.name) + "'";
 }
 
+// Loads act on movable bodies, prescribed motions on fixed ones (checked when a body is added and before
+// every step, since bodies() is writable); null if the body is consistent.
+const char* motion_problem(const RigidBody& body) {
+  if (!body.fixed)
+    return body.motion == PrescribedMotion::none
+               ? nullptr
+               : "a prescribed motion applies to fixed bodies only; this body is movable";
+  if (body.loaded())
+    return "a fixed body has infinite mass, so an applied force or torque would do nothing; give it a "
+           "prescribed motion instead";
+  if (body.motion == PrescribedMotion::none && !(body.velocity.isZero(0.0) && body.angular_velocity.isZero(0.0)))
+    return "a fixed body with velocities needs a prescribed motion (moving or surface)";
+  return nullptr;
+}
+
 // Physical validity of a body handed to the world. The scene loader checks the same values with file
 // positions; this catches bodies built in code.
 void validate_body(const RigidBody& body, std::size_t index) {
@@ -42,6 +57,9 @@ void validate_body(const RigidBody& body, std::size_t index) {
     throw Error(label + ": restitution must be finite and >= 0, got " + std::to_string(body.material.restitution));
   if (std::holds_alternative<Plane>(body.shape) && !body.fixed)
     throw Error(label + ": a plane is an infinite half-space and must be fixed");
+  if (!all_finite(body.force_body) || !all_finite(body.torque_body))
+    throw Error(label + ": body-frame loads must be finite");
+  if (const char* why = motion_problem(body)) throw Error(label + ": " + why);
   if (body.fixed) return;
   if (!(body.mass > 0.0) || !std::isfinite(body.mass) || !(std::abs(body.inv_mass * body.mass - 1.0) < 1e-9))
     throw Error(label + ": mass must be positive and finite with inv_mass = 1/mass, got mass " +
@@ -70,6 +88,23 @@ void check_friction(CollisionResolver& resolver, const RigidBody& body, std::siz
                 "; set its friction to 0 or choose a resolver (or mode) that models friction, such as ledas or mirtich");
 }
 
+// Contact convention (modules/contact.hpp): P = p n + p_t acts +P on b and −P on a. In the frame of a
+// fixed body moving at u_f the contact only dissipates; back in the world frame the movable body's
+// kinetic energy changes by that plus P_received·u_f, the work the prescribed motion does.
+double prescribed_contact_work(std::span<const RigidBody> bodies, std::span<const Contact> contacts) {
+  double work = 0.0;
+  for (const Contact& c : contacts) {
+    const RigidBody &a = bodies[c.a], &b = bodies[c.b];
+    if (a.fixed == b.fixed) continue;
+    const RigidBody& driver = a.fixed ? a : b;
+    if (driver.motion == PrescribedMotion::none) continue;
+    const Vec3 impulse = c.impulse * c.normal + c.tangent_impulse;
+    const Vec3 received = a.fixed ? impulse : Vec3(-impulse);  // by the movable body
+    work += received.dot(driver.velocity_at(c.point));
+  }
+  return work;
+}
+
 }  // namespace
 
 World::World(WorldSettings settings) : settings_(std::move(settings)) {
@@ -87,8 +122,60 @@ BodyIndex World::add_body(RigidBody body) {
   if (resolver_) check_friction(*resolver_, body, bodies_.size());
   if (body.fixed) make_fixed(body);
   bodies_.push_back(std::move(body));
+  handles_.push_back(BodyHandle{next_handle_++});
   detector_stale_ = true;
   return static_cast<BodyIndex>(bodies_.size() - 1);
+}
+
+BodyHandle World::handle(BodyIndex index) const {
+  if (index >= handles_.size())
+    throw Error("world: no body has index " + std::to_string(index) + " (there are " +
+                std::to_string(bodies_.size()) + ")");
+  return handles_[index];
+}
+
+std::optional<BodyIndex> World::index_of(BodyHandle handle) const {
+  const auto it = std::lower_bound(handles_.begin(), handles_.end(), handle);
+  if (it == handles_.end() || *it != handle) return std::nullopt;
+  return static_cast<BodyIndex>(it - handles_.begin());
+}
+
+std::size_t World::remove_body(BodyHandle handle) {
+  const std::optional<BodyIndex> index = index_of(handle);
+  if (!index)
+    throw Error("world: no body has handle " + std::to_string(handle.value) +
+                (handle.value > 0 && handle.value < next_handle_ ? " (it was removed)" : " (it was never added)"));
+  return remove_at(*index);
+}
+
+std::size_t World::remove_body(const std::string& name) {
+  const std::optional<BodyIndex> index = find_body(name);
+  if (!index) throw Error("world: no body named '" + name + "' (never added, or already removed)");
+  return remove_at(*index);
+}
+
+std::size_t World::remove_at(BodyIndex index) {
+  std::vector<std::int64_t> new_index(bodies_.size());
+  for (std::size_t i = 0; i < bodies_.size(); ++i)
+    new_index[i] = i < index ? static_cast<std::int64_t>(i) : i == index ? -1 : static_cast<std::int64_t>(i) - 1;
+  const std::size_t before = constraints_.size();
+  std::erase_if(constraints_, [&](const Constraint& c) {
+    const ConstraintEnds pp = ends_of(c);
+    return pp.a == index || pp.b == index;
+  });
+  for (Constraint& constraint : constraints_)
+    std::visit(
+        [&](auto& c) {
+          c.a = static_cast<BodyIndex>(new_index[c.a]);
+          c.b = static_cast<BodyIndex>(new_index[c.b]);
+        },
+        constraint);
+  bodies_.erase(bodies_.begin() + index);
+  handles_.erase(handles_.begin() + index);
+  contacts_.clear();  // they name bodies by their old indices
+  detector_stale_ = true;
+  if (resolver_) resolver_->bodies_removed(new_index);
+  return before - constraints_.size();
 }
 
 void World::add_constraint(Constraint constraint) {
@@ -165,6 +252,7 @@ void World::resolve(StepStatus& status) {
     const double kinetic = total_kinetic_energy(bodies_), potential = load_potential_energy(bodies_, settings_.gravity);
     resolver_->resolve(bodies_, contacts_, constraints_, context(), status.resolver);
     status.resolve_kinetic_energy_change = total_kinetic_energy(bodies_) - kinetic;
+    status.prescribed_work = prescribed_contact_work(bodies_, contacts_);
     status.resolve_potential_energy_change = load_potential_energy(bodies_, settings_.gravity) - potential;
   }
   status.profile.resolve = seconds_since(start);
@@ -208,8 +296,23 @@ void World::restore_snapshot() {
   }
 }
 
+// Fixed bodies that move do so exactly: x += dt v, R ← Q(ω dt) R with Rodrigues' matrix (rigid motion
+// at constant world-frame velocities), re-orthonormalized so that rounding cannot accumulate over a
+// long run. The integrator plugins never see them (they skip fixed bodies).
+void World::move_prescribed() {
+  const double dt = settings_.dt;
+  for (RigidBody& body : bodies_) {
+    if (!body.fixed || body.motion != PrescribedMotion::moving) continue;
+    body.position += dt * body.velocity;
+    if (!body.angular_velocity.isZero(0.0))
+      body.rotation = orthonormalized(rotation_from_vector(dt * body.angular_velocity) * body.rotation);
+  }
+}
+
 const StepStatus& World::step() {
   if (!integrator_) throw Error("world: no integrator set");
+  for (std::size_t i = 0; i < bodies_.size(); ++i)
+    if (const char* why = motion_problem(bodies_[i])) throw Error(body_label(bodies_[i], i) + ": " + why);
   const auto start = Clock::now();
   status_ = StepStatus{};
   take_snapshot();
@@ -232,15 +335,21 @@ const StepStatus& World::step() {
       resolve(status_);
       ok = check_finite(status_, "resolution");
     }
-    // 4. positions: move with the resolved velocities
+    // 4. positions: move with the resolved velocities; fixed bodies with their prescribed motion
     if (ok) {
-      timed(status_.profile.positions, [&] { integrator_->integrate_positions(bodies_, ctx, status_.integrator); });
+      timed(status_.profile.positions, [&] {
+        integrator_->integrate_positions(bodies_, ctx, status_.integrator);
+        move_prescribed();
+      });
       ok = check_finite(status_, "position integration");
     }
   } else {
     // The paper's order (sec. 2): integrate fully, then detect and resolve at the new positions.
     timed(status_.profile.velocities, [&] { integrator_->integrate_velocities(bodies_, ctx, status_.integrator); });
-    timed(status_.profile.positions, [&] { integrator_->integrate_positions(bodies_, ctx, status_.integrator); });
+    timed(status_.profile.positions, [&] {
+      integrator_->integrate_positions(bodies_, ctx, status_.integrator);
+      move_prescribed();
+    });
     ok = check_finite(status_, "integration");
     if (ok) detect(status_);
     if (ok) {

@@ -145,6 +145,10 @@ SceneProblem scene_problem(std::span<const RigidBody> bodies, std::span<const Co
       }
     }
     g.w(static_cast<Eigen::Index>(3 * k)) = -std::min(0.0, c.depth) / dt;
+    // A fixed body's prescribed velocity at the contact is a constant part of the relative velocity.
+    const Vec3 prescribed = (bodies[c.b].fixed ? bodies[c.b].velocity_at(c.point) : Vec3::Zero()) -
+                            (bodies[c.a].fixed ? bodies[c.a].velocity_at(c.point) : Vec3::Zero());
+    for (int d = 0; d < 3; ++d) g.w(static_cast<Eigen::Index>(3 * k + static_cast<std::size_t>(d))) += frame[d].dot(prescribed);
     g.mu.push_back(combined_friction(bodies[c.a], bodies[c.b]));
   }
   g.h.resize(n, rows);

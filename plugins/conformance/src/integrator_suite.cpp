@@ -115,6 +115,32 @@ TEST_P(IntegratorConformance, LeavesFixedBodiesAloneAndCountsTheMovableOnes) {
   EXPECT_EQ(counters.bodies, 100u);
 }
 
+// Law: a body-frame load acts as its world-frame image R F_body, R τ_body at the step's starting pose
+// (RigidBody::applied_force, applied_torque): one step with either gives the same state to rounding.
+TEST_P(IntegratorConformance, AppliesBodyFrameLoadsAsTheirWorldFrameImages) {
+  const auto integrator = load_integrator(GetParam());
+  std::vector<RigidBody> in_body = tumbling_body();
+  in_body[0].rotation = rotation_from_vector(Vec3(0.4, -0.7, 1.1));
+  in_body[0].force_body = Vec3(3.0, -1.0, 0.5);
+  in_body[0].torque_body = Vec3(0.2, 0.4, -0.3);
+  std::vector<RigidBody> in_world = in_body;
+  in_world[0].force = in_body[0].rotation * in_body[0].force_body;
+  in_world[0].torque = in_body[0].rotation * in_body[0].torque_body;
+  in_world[0].force_body.setZero();
+  in_world[0].torque_body.setZero();
+  run(*integrator, in_body, StepContext{}, 1);
+  run(*integrator, in_world, StepContext{}, 1);
+  // Rounding of one rotation product: 1e-14 relative to velocities of order 1.
+  EXPECT_LT((in_body[0].velocity - in_world[0].velocity).norm(), 1e-14);
+  EXPECT_LT((in_body[0].angular_velocity - in_world[0].angular_velocity).norm(), 1e-14);
+  EXPECT_LT((in_body[0].position - in_world[0].position).norm(), 1e-14);
+  // And the load did act: the step differs from one without it by dt F/m at least.
+  std::vector<RigidBody> unloaded = tumbling_body();
+  unloaded[0].rotation = in_body[0].rotation;
+  run(*integrator, unloaded, StepContext{}, 1);
+  EXPECT_GT((in_body[0].velocity - unloaded[0].velocity).norm(), 1e-4);
+}
+
 // Refusal: an option the integrator does not read is refused when it is loaded, with a message naming it.
 TEST_P(IntegratorConformance, RefusesAnUnknownOption) {
   const std::string message = unknown_option_message(GetParam(), ModuleKind::integrator, "conformance_no_such_option");

@@ -10,7 +10,8 @@
 
 namespace impetus {
 
-/// Advances the bodies' state in time. Implementations skip fixed bodies.
+/// Advances the bodies' state in time. Implementations skip fixed bodies (the world moves those with a
+/// prescribed motion itself) and apply RigidBody::applied_force() and applied_torque().
 class Integrator {
  public:
   virtual ~Integrator() = default;

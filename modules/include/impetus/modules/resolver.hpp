@@ -9,11 +9,14 @@
 #include "impetus/modules/status.hpp"
 #include "impetus/modules/step.hpp"
 
+#include <cstdint>
 #include <span>
 
 namespace impetus {
 
-/// Changes body velocities by impulses so that no contact approaches (and constraints hold). A resolver
+/// Changes body velocities by impulses so that no contact approaches (and constraints hold). A fixed
+/// body never changes, but it may have velocities (a prescribed motion): relative velocities take every
+/// body's velocity_at() the contact point, fixed or not. A resolver
 /// may also correct penetration by moving positions directly, provided it leaves velocities (and so
 /// kinetic energy) untouched by that correction.
 class CollisionResolver {
@@ -44,6 +47,11 @@ class CollisionResolver {
     (void)solution;
     return ModuleStatus::failure("this resolver does not solve contact problems in local form");
   }
+
+  /// Told when bodies were removed from the world between steps: `new_index[i]` is the new index of
+  /// the body that had index i, or −1 for a removed body. A resolver that carries anything keyed by body
+  /// index from step to step (warm starts) renumbers or drops it here. The default keeps nothing.
+  virtual void bodies_removed(std::span<const std::int64_t> new_index) noexcept { (void)new_index; }
 
   /// Applies impulses to `bodies` for `contacts` (writing each contact's total `impulse`,
   /// `tangent_impulse` and `mode`) and

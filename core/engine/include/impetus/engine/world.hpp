@@ -57,9 +57,20 @@ struct StepStatus {
   /// the resolve stage minus before it (J): what a resolver's position correction (moving bodies out of
   /// penetration) adds. 0 when nothing was resolved or positions were not corrected.
   double resolve_potential_energy_change = 0.0;
+  /// Work of the contact impulses that fixed bodies with a prescribed motion exert, Σ P·u_fixed(point)
+  /// over their contacts with movable bodies (J): energy such a body puts in (a pusher) or takes out. It is
+  /// part of resolve_kinetic_energy_change, so the contacts' own dissipation is that change minus this.
+  double prescribed_work = 0.0;
   std::uint64_t nan_caught = 0;  ///< bodies whose state became non-finite (restored to before the step)
   bool ok = true;                ///< false when anything non-finite was caught
   std::string message;           ///< why not ok, naming the body and the stage
+};
+
+/// A body's handle: stable for the world's lifetime, never reused, unlike its index (which shifts down
+/// when an earlier body is removed). 0 is no body.
+struct BodyHandle {
+  std::uint64_t value = 0;
+  auto operator<=>(const BodyHandle&) const = default;
 };
 
 /// A simulation world. Not copyable (it owns module instances).
@@ -71,8 +82,21 @@ class World {
   World& operator=(const World&) = delete;
 
   /// Adds a body after validating it (finite state, positive mass and inertia for a movable body,
-  /// unique name, planes only on fixed bodies). Throws Error naming the body otherwise.
+  /// unique name, planes only on fixed bodies, loads only on movable ones, a prescribed motion only on
+  /// fixed ones and velocities on a fixed body only with one). Throws Error naming the body otherwise.
+  /// The body's index is bodies().size() before the call; handle(index) gives its stable handle. May be
+  /// called between steps: the detector is told before the next detection.
   BodyIndex add_body(RigidBody body);
+  /// Removes a body between steps, with the constraints that join it (returns how many). Later bodies'
+  /// indices shift down by one, constraints are renumbered, the last contacts are cleared, the detector
+  /// is told before the next detection and the resolver at once (CollisionResolver::bodies_removed).
+  /// Throws Error if the handle or name names no body (never added, or already removed).
+  std::size_t remove_body(BodyHandle handle);
+  std::size_t remove_body(const std::string& name);
+  /// The stable handle of the body at `index` (which must be < bodies().size()).
+  BodyHandle handle(BodyIndex index) const;
+  /// The current index of the body with `handle`, if it is still in the world.
+  std::optional<BodyIndex> index_of(BodyHandle handle) const;
   /// Adds a constraint between two existing bodies. Throws Error for a bad index.
   void add_constraint(Constraint constraint);
 
@@ -82,7 +106,9 @@ class World {
   void set_detector(std::shared_ptr<CollisionDetector> detector);
   void set_resolver(std::shared_ptr<CollisionResolver> resolver);
 
-  /// Advances the world by one step of settings().dt. Returns the step's status (also kept as
+  /// Advances the world by one step of settings().dt. Fixed bodies with PrescribedMotion::moving move
+  /// with their velocities in the positions stage. Throws Error if a body's loads or motion became
+  /// inconsistent (see add_body) since it was added. Returns the step's status (also kept as
   /// last_status()). A non-finite state is caught, reported, and rolled back to before the step.
   const StepStatus& step();
 
@@ -116,6 +142,8 @@ class World {
   bool check_finite(StepStatus& status, const char* stage);
   void take_snapshot();
   void restore_snapshot();
+  void move_prescribed();
+  std::size_t remove_at(BodyIndex index);
 
   struct BodyState {
     Vec3 position;
@@ -126,6 +154,8 @@ class World {
 
   WorldSettings settings_;
   std::vector<RigidBody> bodies_;
+  std::vector<BodyHandle> handles_;  // per body, increasing (removal keeps the order)
+  std::uint64_t next_handle_ = 1;
   std::vector<Constraint> constraints_;
   std::vector<Contact> contacts_;
   std::vector<BodyState> snapshot_;  // state before the step, for rollback on NaN

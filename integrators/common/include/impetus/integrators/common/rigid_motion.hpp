@@ -26,9 +26,9 @@ struct RotationSettings {
   static RotationSettings from_options(const ModuleOptions& options);
 };
 
-/// Eq. 2, rows 1–2: gravity `ctx.gravity` (m/s²), the applied force `body.force` (N) and torque
-/// `body.torque` (N·m, world frame) change the velocities over `ctx.dt`. Angular momentum changes by
-/// dt τ; at the current R that is exactly ω += dt J_world⁻¹ τ, so this one update serves integrators
+/// Eq. 2, rows 1–2: gravity `ctx.gravity` (m/s²), the applied force `body.applied_force()` (N) and
+/// torque `body.applied_torque()` (N·m, world frame; body-frame loads turned at the current pose) change
+/// the velocities over `ctx.dt`. Angular momentum changes by dt τ; at the current R that is exactly ω += dt J_world⁻¹ τ, so this one update serves integrators
 /// that carry ω and those that carry L. The body must not be fixed.
 void integrate_velocity(RigidBody& body, const StepContext& ctx);
 

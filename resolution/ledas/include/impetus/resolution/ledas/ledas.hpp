@@ -142,6 +142,9 @@ class LedasResolver final : public CollisionResolver {
   ModuleStatus solve_contact_problem(const LocalContactProblem& problem,
                                      LocalContactSolution& solution) noexcept override;
 
+  /// Renumbers the warm starts kept from the last step and drops those of removed bodies.
+  void bodies_removed(std::span<const std::int64_t> new_index) noexcept override;
+
   /// Resolves `contacts` and `constraints` (see the class comment), writing Contact::impulse.
   void resolve(std::span<RigidBody> bodies, std::span<Contact> contacts, std::span<const Constraint> constraints,
                const StepContext& ctx, ResolverCounters& counters) noexcept override;
