@@ -25,8 +25,11 @@
 
 namespace impetus::bench {
 
-/// A counter's value as text: whole numbers in full, anything else in `%.3g`.
+/// A counter's value as text: whole numbers in full, anything else in `%.3g`; "nan" and "0" unsigned
+/// (an aggregate of equal values has a coefficient of variation of −0 or −nan).
 inline std::string plain_number(double value) {
+  if (std::isnan(value)) return "nan";
+  if (value == 0.0) return "0";
   char text[32];
   if (std::isfinite(value) && value == std::round(value) && std::abs(value) < 1e15)
     std::snprintf(text, sizeof text, "%.0f", value);
