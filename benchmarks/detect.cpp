@@ -2,6 +2,8 @@
 // on towers of resting boxes, with the broadphase / narrowphase split measured inside the detector
 // (FclDetector::last_profile(), steady clock). Every iteration nudges the movable bodies by ±1 nm so
 // the broadphase refreshes every box and updates its tree as in a real step; contacts are unchanged.
+#include "support/bench_main.hpp"
+
 #include "impetus/detection/fcl/fcl_detector.hpp"
 #include "impetus/engine/generators.hpp"
 
@@ -82,4 +84,4 @@ BENCHMARK(resting_boxes)->Name("detect/resting_boxes")->Arg(1000)->Arg(10000)->U
 
 }  // namespace
 
-BENCHMARK_MAIN();
+IMPETUS_BENCHMARK_MAIN();

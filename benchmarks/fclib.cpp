@@ -14,6 +14,8 @@
 //   exact                   error ≤ 1e-10; solved_1e8: error ≤ 1e-8 (the published comparison's tolerance)
 // `benchmarks/fclib_report.py` turns the JSON into a table and a performance profile (the fraction of
 // problems solved to 1e-8 and 1e-10 within a time).
+#include "support/bench_main.hpp"
+
 #include "impetus/core/error.hpp"
 #include "impetus/engine/scene.hpp"
 #include "impetus/engine/world.hpp"
@@ -194,7 +196,7 @@ std::string take_flag(int& argc, char** argv, const char* flag) {
 int main(int argc, char** argv) {
   const std::string dir = take_flag(argc, argv, "--dir");
   std::string keep = take_flag(argc, argv, "--export");
-  benchmark::Initialize(&argc, argv);
+  const auto reporter = bench::initialize(&argc, argv);
   if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 1;
   try {
     std::vector<fs::path> files;
@@ -213,7 +215,7 @@ int main(int argc, char** argv) {
     }
     for (const fs::path& file : files)
       benchmark::RegisterBenchmark(("fclib/" + file.stem().string()).c_str(), solve, file)->Unit(benchmark::kMillisecond);
-    benchmark::RunSpecifiedBenchmarks();
+    benchmark::RunSpecifiedBenchmarks(reporter.get());
     benchmark::Shutdown();
     if (keep.empty() && dir.empty())
       for (const fs::path& file : files) fs::remove(file);

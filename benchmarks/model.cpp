@@ -18,6 +18,7 @@
 //   start_set     one sphere pyramid K = 20 on the fixed ground, the paper's drop velocities: the ledas
 //                 search starts with the impact's contacts (on, `start_set: impact`) or with every
 //                 touching contact (off, `start_set: touching`): the same answer, another first guess.
+#include "support/bench_main.hpp"
 #include "support/bench_steps.hpp"
 
 #include "impetus/engine/scene.hpp"
@@ -128,4 +129,4 @@ const int registered = register_all();
 
 }  // namespace
 
-BENCHMARK_MAIN();
+IMPETUS_BENCHMARK_MAIN();

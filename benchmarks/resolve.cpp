@@ -20,6 +20,7 @@
 //                           same measure for every resolver
 //   sticking, sliding       contacts the resolver reports sticking and sliding
 //   exact                   natural_map ≤ 1e-9 and no approach left (≤ 1e-9 m/s)
+#include "support/bench_main.hpp"
 #include "support/bench_resolvers.hpp"
 #include "support/bench_scenes.hpp"
 
@@ -136,4 +137,4 @@ const int registered = register_all();
 
 }  // namespace
 
-BENCHMARK_MAIN();
+IMPETUS_BENCHMARK_MAIN();

@@ -10,6 +10,7 @@
 // equilibrium exists) and stacks of N unit boxes on the ground (μ = 0.5), each step the frictional
 // problem of a resting scene; counters add natural_map (ledas's natural-map residual), sticking and
 // sliding.
+#include "support/bench_main.hpp"
 #include "support/bench_resolvers.hpp"
 #include "support/bench_scenes.hpp"
 #include "support/bench_steps.hpp"
@@ -122,4 +123,4 @@ const int registered = register_all();
 
 }  // namespace
 
-BENCHMARK_MAIN();
+IMPETUS_BENCHMARK_MAIN();

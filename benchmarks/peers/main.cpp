@@ -18,6 +18,8 @@
 //   solver_ms               the engine's solver alone, mean per step (NaN where it cannot be separated)
 #include "peers.hpp"
 
+#include "support/bench_main.hpp"
+
 #include <benchmark/benchmark.h>
 
 #include <cmath>
@@ -141,9 +143,9 @@ int main(int argc, char** argv) {
   std::fprintf(stderr, " Impetus (ledas, ledas_paper, mirtich)\n");
   add_impetus_methods(methods());
   register_all();
-  benchmark::Initialize(&argc, argv);
+  const auto reporter = bench::initialize(&argc, argv);
   if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 1;
-  benchmark::RunSpecifiedBenchmarks();
+  benchmark::RunSpecifiedBenchmarks(reporter.get());
   benchmark::Shutdown();
   return 0;
 }
