@@ -54,7 +54,7 @@ function(impetus_add_module_library target)
   if(ARG_INCLUDE_DIR)
     target_include_directories(${target} PUBLIC ${ARG_INCLUDE_DIR})
   endif()
-  target_link_libraries(${target} PUBLIC Impetus::plugin_api ${ARG_PUBLIC_LIBRARIES}
+  target_link_libraries(${target} PUBLIC Impetus::plugin_api Impetus::settings ${ARG_PUBLIC_LIBRARIES}
                                   PRIVATE ${ARG_PRIVATE_LIBRARIES})
   if(TARGET impetus_compile_options)
     target_link_libraries(${target} PRIVATE impetus_compile_options)

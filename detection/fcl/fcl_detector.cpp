@@ -55,14 +55,6 @@ std::string size_problem(const ShapeGeometry& g) {
 
 }  // namespace
 
-FclDetectorSettings FclDetectorSettings::from_options(const ModuleOptions& options) {
-  FclDetectorSettings s;
-  s.margin = options.number("margin", s.margin, 0.0, 1e3);
-  s.max_contacts_per_pair = static_cast<int>(options.integer("max_contacts_per_pair", s.max_contacts_per_pair, 0, 4));
-  s.merge_tolerance = options.number("merge_tolerance", s.merge_tolerance, 0.0, 0.5);
-  return s;
-}
-
 struct FclDetector::Impl {
   struct Body {
     ShapeGeometry geometry;

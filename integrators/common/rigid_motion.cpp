@@ -2,12 +2,6 @@
 
 namespace impetus::integrators {
 
-RotationSettings RotationSettings::from_options(const ModuleOptions& options) {
-  RotationSettings settings;
-  settings.orthonormalize = options.boolean("orthonormalize", settings.orthonormalize);
-  return settings;
-}
-
 void integrate_velocity(RigidBody& body, const StepContext& ctx) {
   // eq. (2), row 1: the force acts through the center of mass. Body-frame loads are turned into the
   // world frame at the pose the step starts from.

@@ -22,33 +22,6 @@ bool valid_contact(const Contact& c, std::size_t body_count) {
 
 }  // namespace
 
-LedasSettings LedasSettings::from_options(const ModuleOptions& options) {
-  LedasSettings s;
-  s.mode = options.choice("mode", "complementary", {"paper", "complementary"}) == "paper" ? LedasMode::paper
-                                                                                         : LedasMode::complementary;
-  s.tolerance = options.number("tolerance", s.tolerance, 0.0, 1.0);
-  s.start_set = options.choice("start_set", "impact", {"impact", "touching"}) == "touching" ? LedasStartSet::touching
-                                                                                         : LedasStartSet::impact;
-  s.max_rounds = static_cast<std::uint64_t>(
-      options.integer("max_rounds", static_cast<long long>(s.max_rounds), 1, 1'000'000'000));
-  s.solver.dense_limit = static_cast<std::size_t>(
-      options.integer("dense_limit", static_cast<long long>(s.solver.dense_limit), 1, 100'000));
-  s.solver.polish_limit = static_cast<std::size_t>(
-      options.integer("polish_limit", static_cast<long long>(s.solver.polish_limit), 0, 100'000));
-  s.solver.rank_tolerance = options.number("rank_tolerance", s.solver.rank_tolerance, 1e-16, 1e-2);
-  s.solver.update_limit = static_cast<std::size_t>(
-      options.integer("update_limit", static_cast<long long>(s.solver.update_limit), 0, 10'000));
-  s.solver.regularization = options.number("regularization", s.solver.regularization, 1e-16, 1e-2);
-  s.solver.search_regularization =
-      options.number("search_regularization", s.solver.search_regularization, 0.0, 1e-1);
-  s.solver.sharpen_refinement = options.boolean("sharpen_refinement", s.solver.sharpen_refinement);
-  s.solver.max_iterations = s.max_rounds;
-  s.islands = options.boolean("islands", s.islands);
-  s.warm_start = options.boolean("warm_start", s.warm_start);
-  s.resting = resolution::RestingSettings::from_options(options);
-  return s;
-}
-
 LedasResolver::LedasResolver(const ModuleOptions& options) : LedasResolver(LedasSettings::from_options(options)) {}
 
 LedasResolver::LedasResolver(const LedasSettings& settings) : settings_(settings), solver_([&] {

@@ -225,23 +225,6 @@ void record_outcomes(const Workspace& ws, std::span<Contact> contacts, std::span
 
 }  // namespace
 
-MirtichSettings MirtichSettings::from_options(const ModuleOptions& options) {
-  MirtichSettings s;
-  s.order = options.choice("order", "most_approaching", {"most_approaching", "index"}) == "index"
-                ? MirtichOrder::index
-                : MirtichOrder::most_approaching;
-  s.tolerance = options.number("tolerance", s.tolerance, 0.0, 1e3);
-  s.max_impulses = static_cast<std::uint64_t>(options.integer("max_impulses", 0, 0, 1'000'000'000'000LL));
-  s.position_iterations = static_cast<int>(options.integer("position_iterations", s.position_iterations, 0, 100000));
-  s.resting = resolution::RestingSettings::from_options(options);
-  return s;
-}
-
-std::uint64_t MirtichSettings::impulse_cap(std::size_t contacts) const {
-  if (max_impulses > 0) return max_impulses;
-  return std::max<std::uint64_t>(10000, 100 * static_cast<std::uint64_t>(contacts));
-}
-
 MirtichResolver::MirtichResolver(const ModuleOptions& options) : settings_(MirtichSettings::from_options(options)) {}
 
 MirtichResolver::MirtichResolver(const MirtichSettings& settings) : settings_(settings) {}

@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
-# usage: run_embed_example.sh BUILD_DIR EXAMPLE_SRC WORK_DIR [PLUGIN_TEMPLATE_SRC]
+# usage: run_embed_example.sh BUILD_DIR EXAMPLE_SRC WORK_DIR [PLUGIN_TEMPLATE_SRC [TYPED_EXAMPLE_SRC]]
 set -euo pipefail
-build=$1 example=$2 work=$3 template=${4:-}
+build=$1 example=$2 work=$3 template=${4:-} typed=${5:-}
 rm -rf "$work"
 mkdir -p "$work"
 cmake --install "$build" --prefix "$work/staging" >/dev/null
@@ -9,6 +9,12 @@ mv "$work/staging" "$work/prefix"   # relocated: nothing may point back at the s
 cmake -S "$example" -B "$work/build" -G Ninja -DCMAKE_PREFIX_PATH="$work/prefix" >/dev/null
 cmake --build "$work/build" >/dev/null
 "$work/build/embed" "$work/prefix/share/impetus/scenes/demo.yaml"
+# The second way to embed: typed settings in code, and a scene with its resolver swapped by an override.
+if [[ -n "$typed" ]]; then
+  cmake -S "$typed" -B "$work/typed" -G Ninja -DCMAKE_PREFIX_PATH="$work/prefix" >/dev/null
+  cmake --build "$work/typed" >/dev/null
+  "$work/typed/typed"
+fi
 "$work/prefix/bin/impetus" plugins | grep -q "$work/prefix/.*impetus_integrator_euler.so" || {
   echo "installed impetus does not find its own plugins" >&2; "$work/prefix/bin/impetus" plugins >&2; exit 1; }
 # Meshes are imported by the importer program, which the relocated library must find in its own prefix.

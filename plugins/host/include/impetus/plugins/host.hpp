@@ -17,6 +17,7 @@
 #include "impetus/modules/resolver.hpp"
 #include "impetus/plugins/abi.hpp"
 
+#include <concepts>
 #include <filesystem>
 #include <map>
 #include <memory>
@@ -88,6 +89,45 @@ class PluginHost {
   std::shared_ptr<CollisionDetector> create_detector(const PluginRequest& request);
   std::shared_ptr<CollisionResolver> create_resolver(const PluginRequest& request);
 
+  /// Typed settings (impetus/settings/: LedasSettings, MirtichSettings, FclDetectorSettings,
+  /// EulerSettings, …; any type with `ModuleOptions to_options() const` and `plugin_name`):
+  /// `host.create_resolver(settings)` loads the plugin the type names with the options the settings
+  /// stand for; `host.create_resolver("name", settings)` loads another plugin that reads the same
+  /// options. The options go through the same checks as a scene's; messages start with "code".
+  template <class Settings>
+    requires requires(const Settings& s) { { s.to_options() } -> std::same_as<ModuleOptions>; }
+  std::shared_ptr<Integrator> create_integrator(const Settings& settings, const std::string& name = Settings::plugin_name) {
+    ModuleOptions options = settings.to_options();
+    return create_integrator(typed_request(ModuleKind::integrator, name, options));
+  }
+  template <class Settings>
+    requires requires(const Settings& s) { { s.to_options() } -> std::same_as<ModuleOptions>; }
+  std::shared_ptr<CollisionDetector> create_detector(const Settings& settings, const std::string& name = Settings::plugin_name) {
+    ModuleOptions options = settings.to_options();
+    return create_detector(typed_request(ModuleKind::detector, name, options));
+  }
+  template <class Settings>
+    requires requires(const Settings& s) { { s.to_options() } -> std::same_as<ModuleOptions>; }
+  std::shared_ptr<CollisionResolver> create_resolver(const Settings& settings, const std::string& name = Settings::plugin_name) {
+    ModuleOptions options = settings.to_options();
+    return create_resolver(typed_request(ModuleKind::resolver, name, options));
+  }
+  template <class Settings>
+    requires requires(const Settings& s) { { s.to_options() } -> std::same_as<ModuleOptions>; }
+  std::shared_ptr<CollisionResolver> create_resolver(const std::string& name, const Settings& settings) {
+    return create_resolver(settings, name);
+  }
+  template <class Settings>
+    requires requires(const Settings& s) { { s.to_options() } -> std::same_as<ModuleOptions>; }
+  std::shared_ptr<CollisionDetector> create_detector(const std::string& name, const Settings& settings) {
+    return create_detector(settings, name);
+  }
+  template <class Settings>
+    requires requires(const Settings& s) { { s.to_options() } -> std::same_as<ModuleOptions>; }
+  std::shared_ptr<Integrator> create_integrator(const std::string& name, const Settings& settings) {
+    return create_integrator(settings, name);
+  }
+
   /// Loads every `impetus_*.so` in the search path and reports what each is, or why it failed. A file
   /// named `impetus_<kind>_<name>.so` must declare that kind and name. A kind+name already found in an
   /// earlier directory is listed as shadowed; found twice in one directory, the second file (files
@@ -96,6 +136,14 @@ class PluginHost {
 
  private:
   std::shared_ptr<void> create(const PluginRequest& request);
+  static PluginRequest typed_request(ModuleKind kind, const std::string& name, ModuleOptions& options) {
+    PluginRequest request;
+    request.kind = kind;
+    request.name = name;
+    request.options = &options;
+    request.where = "code";
+    return request;
+  }
   // Opens `file` (or reuses it if already open) and runs the ABI checks; null with `reason` on failure.
   std::shared_ptr<LoadedLibrary> load(const std::filesystem::path& file, std::string& reason);
   // First `impetus_<kind>_<name>.so` in the search path; empty if none.

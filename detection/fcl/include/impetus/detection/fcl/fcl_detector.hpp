@@ -10,27 +10,12 @@
 
 #include "impetus/modules/detector.hpp"
 #include "impetus/modules/options.hpp"
+#include "impetus/settings/fcl.hpp"  // FclDetectorSettings
 
 #include <cstdint>
 #include <memory>
 
 namespace impetus {
-
-/// Settings of the `fcl` detector (scene options of the same names).
-struct FclDetectorSettings {
-  /// Bodies within this distance of touching produce contacts, with depth = −gap (m, ≥ 0). It makes
-  /// resting and exactly touching bodies robust to rounding; keep it far below the bodies' size.
-  double margin = 1e-4;
-  /// Most contacts kept per body pair (1…4), chosen to span the largest area; 0 keeps every point (no
-  /// reduction: benchmarks/model.cpp measures what the reduction saves).
-  int max_contacts_per_pair = 4;
-  /// Points of one pair closer than this × the smaller body's bounding radius are merged into the
-  /// deeper one (relative, 0 … 0.5).
-  double merge_tolerance = 1e-3;
-
-  /// Reads `margin`, `max_contacts_per_pair` and `merge_tolerance`; throws OptionError on a bad value.
-  static FclDetectorSettings from_options(const ModuleOptions& options);
-};
 
 /// What the last detect() cost and had to correct, beyond DetectorCounters (not part of the module
 /// contract: benchmarks and tests read it from the plain class).

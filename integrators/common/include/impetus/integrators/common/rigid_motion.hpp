@@ -13,18 +13,9 @@
 #include "impetus/core/body.hpp"
 #include "impetus/modules/options.hpp"
 #include "impetus/modules/step.hpp"
+#include "impetus/settings/integrators.hpp"  // RotationSettings
 
 namespace impetus::integrators {
-
-/// Options of the rotation step, shared by every eq. 2 integrator.
-struct RotationSettings {
-  /// Re-orthonormalize R after every rotation step (the paper, after eq. 2), counted in
-  /// IntegratorCounters::orthonormalized. Scene option `orthonormalize` (bool, default true).
-  bool orthonormalize = true;
-
-  /// Reads the options above; throws OptionError on a bad value.
-  static RotationSettings from_options(const ModuleOptions& options);
-};
 
 /// Eq. 2, rows 1–2: gravity `ctx.gravity` (m/s²), the applied force `body.applied_force()` (N) and
 /// torque `body.applied_torque()` (N·m, world frame; body-frame loads turned at the current pose) change

@@ -19,20 +19,11 @@
 
 #include "impetus/modules/options.hpp"
 #include "impetus/resolution/common/impulse_rows.hpp"
+#include "impetus/settings/resting.hpp"  // RestingSettings
 
 #include <algorithm>
 
 namespace impetus::resolution {
-
-/// Resting-contact settings, read from a resolver's options.
-struct RestingSettings {
-  double slop = 1e-4;              ///< penetration left alone (m); option `slop`
-  double correction = 0.2;         ///< fraction of the remaining penetration removed per step, [0, 1]; option `correction`
-  double bounce_threshold = 0.05;  ///< approach speed below which restitution is not applied (m/s); option `bounce_threshold`
-
-  /// Reads `slop`, `correction`, `bounce_threshold`; throws OptionError for a bad value.
-  static RestingSettings from_options(const ModuleOptions& options);
-};
 
 /// The restitution applied at a row of an island whose fastest approach speed is `impact_speed`
 /// (m/s, ≥ 0): the row's coefficient, or 0 below the bounce threshold.

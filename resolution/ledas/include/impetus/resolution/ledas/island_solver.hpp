@@ -27,6 +27,8 @@
 /// unique, the impulses are not); a minimum-norm polish at the end where the system is small.
 /// resolution/ledas/README.md derives it.
 
+#include "impetus/settings/ledas.hpp"  // ledas::SolverSettings
+
 #include <Eigen/Dense>
 #include <Eigen/SparseCholesky>
 #include <Eigen/SparseCore>
@@ -46,30 +48,6 @@ using SparseMatrix = Eigen::SparseMatrix<double>;
 using Vector = Eigen::VectorXd;
 /// Index of a row within an island's system.
 using RowIndex = std::uint32_t;
-
-/// How systems are solved (configuration; read once from the resolver's options).
-struct SolverSettings {
-  std::size_t dense_limit = 64;   ///< systems of at most this many rows use the dense path
-  /// Complementary mode: a final system of at most this many rows gets the minimum-norm impulse split
-  /// (an eigen-decomposition when it is singular, which costs more than the solve itself above ~16 rows).
-  std::size_t polish_limit = 16;
-  double rank_tolerance = 1e-10;  ///< a pivot or eigenvalue ≤ this × max A_ii counts as zero
-  /// Sparse path: largest active-set change solved by an update of the last factorization; 0: automatic,
-  /// max(8, √rows) (an update costs about its rows² × the elimination tree's height, ~√rows on a
-  /// contact network, against ~rows^1.5 for a factorization).
-  std::size_t update_limit = 0;
-  std::uint64_t max_iterations = 10000;  ///< active-set iterations per complementarity problem
-  /// Complementarity problems: proximal regularization ε = this × max A_kk (solve_complementarity): the
-  /// first solve's and the final one.
-  double regularization = 1e-10;
-  /// Complementarity problems: the larger ε = this × max A_kk of the active-set search once the start set
-  /// turned out not to be the answer (solve_complementarity); at most `regularization` disables it.
-  double search_regularization = 1e-3;
-  /// Complementarity problems: the exact solve on a candidate free set (conjugate gradients preconditioned
-  /// by the search's factorization) may refactor at a smaller shift when it predicts that cheaper than
-  /// the steps it would take (refine_on_free_set).
-  bool sharpen_refinement = true;
-};
 
 /// What the solver did, accumulated over calls (reset by the caller).
 struct SolverStats {

@@ -17,6 +17,7 @@
 #include "impetus/resolution/ledas/constraint_rows.hpp"
 #include "impetus/resolution/ledas/frictional_solver.hpp"
 #include "impetus/resolution/ledas/island_solver.hpp"
+#include "impetus/settings/ledas.hpp"  // LedasSettings, LedasMode, LedasStartSet
 
 #include <compare>
 #include <cstdint>
@@ -28,59 +29,6 @@ namespace impetus {
 namespace ledas {
 struct Island;  // one island's working data (island.hpp)
 }  // namespace ledas
-
-/// Which contacts enter the system and how it is solved.
-enum class LedasMode : std::uint8_t {
-  /// The paper's method (sec. 3.2) literally: only approaching contacts (v_n < −tolerance) enter;
-  /// A p = b is solved as equalities, (1 + e) p applied (eq. 3), every contact re-checked, and the
-  /// approaching ones solved again, round after round, until none approaches. Impulses may pull.
-  paper,
-  /// The frictionless inelastic impact solved exactly: approaching and touching contacts enter one
-  /// system; an active set releases pulling impulses and adds approaching contacts until p ≥ 0,
-  /// v_n⁺ ≥ 0, p·v_n⁺ = 0 at every contact (a linear complementarity problem); then (1 + e) p.
-  complementary
-};
-
-/// Which touching contacts the complementary mode's active-set search starts with
-/// (resolution/ledas/README.md, "The start set"). Only the first guess of the active set: the answer is
-/// the same either way.
-enum class LedasStartSet : std::uint8_t {
-  /// Approaching contacts, and the touching ones that can pass the impact on: to a fixed body, or
-  /// between two bodies at different distances (contact hops) from the impact. A touching contact across
-  /// the impact's front (between bodies at the same distance) mostly separates, so it starts out.
-  impact,
-  /// Every approaching or touching contact.
-  touching
-};
-
-/// Configuration (read once from the plugin's options).
-struct LedasSettings {
-  LedasMode mode = LedasMode::complementary;  ///< option `mode: paper | complementary`
-  /// Touch tolerance (m/s): a contact approaches when v_n < target − tolerance and touches when
-  /// v_n ≤ target + tolerance. Option `tolerance`.
-  double tolerance = 1e-9;
-  /// Cap on rounds per island (paper mode; restitution rounds in complementary mode) and on active-set
-  /// iterations per complementarity problem; reaching it counts in non_converged. Option `max_rounds`.
-  std::uint64_t max_rounds = 1000000;
-  /// Complementary mode: the active-set search's first guess. Option `start_set: impact | touching`.
-  LedasStartSet start_set = LedasStartSet::impact;
-  /// Options `dense_limit`, `polish_limit`, `rank_tolerance`, `update_limit`, `regularization`,
-  /// `search_regularization`, `sharpen_refinement` (max_iterations is set to max_rounds).
-  ledas::SolverSettings solver;
-  /// Solve each island (rows connected through movable bodies) on its own (default), or every row in
-  /// one system (`islands: false`: the same velocities up to rounding, with the bounce threshold judged
-  /// over all rows; only slower or faster, as benchmarks/model.cpp measures).
-  bool islands = true;
-  /// Frictional islands start from the last step's impulses of the contacts they still have (matched by
-  /// bodies and the detector's feature key): a resting body's impulses usually solve the next step's
-  /// problem as they are (`warm_start: false` starts every step from its convex relaxation).
-  bool warm_start = true;
-  /// Options `slop`, `correction`, `bounce_threshold` (impetus/resolution/common/resting.hpp).
-  resolution::RestingSettings resting;
-
-  /// Reads every option above; throws OptionError for a bad value.
-  static LedasSettings from_options(const ModuleOptions& options);
-};
 
 /// What the last resolve() did, in more detail than ResolverCounters (for tests and benchmarks).
 struct LedasStats {

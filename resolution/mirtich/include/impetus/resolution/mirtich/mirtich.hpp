@@ -21,39 +21,11 @@
 #include "impetus/modules/resolver.hpp"
 #include "impetus/resolution/common/impulse_rows.hpp"
 #include "impetus/resolution/common/resting.hpp"
+#include "impetus/settings/mirtich.hpp"  // MirtichSettings
 
 #include <cstdint>
 
 namespace impetus {
-
-/// Which approaching contact the sweep resolves next. Both are deterministic for a given contact order.
-enum class MirtichOrder : std::uint8_t {
-  /// The contact with the most negative v_n in its island; ties go to the lower contact index.
-  most_approaching,
-  /// Cyclic passes over the island's contacts in increasing contact index, resolving each approaching
-  /// one as it is met (Gauss–Seidel order).
-  index
-};
-
-/// Configuration of the sequential resolver (read once from the plugin's options).
-struct MirtichSettings {
-  MirtichOrder order = MirtichOrder::most_approaching;  ///< option `order: most_approaching | index`
-  /// A contact approaches when v_n < −tolerance (m/s); the sweep stops when none does. Option `tolerance`.
-  double tolerance = 1e-6;
-  /// Cap on single impulses per island; 0 means automatic: max(10000, 100 × contacts in the island).
-  /// Reaching it stops the sweep and counts the island in ResolverCounters::non_converged.
-  /// Option `max_impulses`.
-  std::uint64_t max_impulses = 0;
-  /// Cap on Gauss–Seidel passes of the position correction per island. Option `position_iterations`.
-  int position_iterations = 50;
-  /// Resting-contact settings: options `slop`, `correction`, `bounce_threshold`.
-  resolution::RestingSettings resting;
-
-  /// Reads every option above; throws OptionError for a bad value.
-  static MirtichSettings from_options(const ModuleOptions& options);
-  /// The impulse cap for an island of `contacts` contacts (max_impulses, or the automatic value).
-  std::uint64_t impulse_cap(std::size_t contacts) const;
-};
 
 /// Sequential single-contact impulses, island by island:
 ///  1. velocity sweep: while some contact approaches (v_n < −tolerance) and the island's cap is not
