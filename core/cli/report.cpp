@@ -30,6 +30,7 @@ RunStats::RunStats(const World& world) : initial_(measure(world)) {
   for (const RigidBody& b : world.bodies()) {
     initial_positions_.push_back(b.position);
     if (!b.fixed) total_mass_ += b.mass;
+    frictional_ = frictional_ || b.material.friction > 0.0;
   }
 }
 
@@ -213,7 +214,8 @@ json RunStats::summary(const World& world, double wall_seconds) const {
         {"max_residual_m_per_s", max_residual_},
         {"max_natural_map_residual", max_natural_map_}}},
       {"friction",
-       {{"sticking_contacts", sticking_}, {"sliding_contacts", sliding_},
+       {{"modelled", frictional_},
+        {"sticking_contacts", sticking_}, {"sliding_contacts", sliding_},
         {"dissipated_j", 0.0 - friction_work_}}},
       {"energy", energy_summary(world)},
       {"momentum", momentum},
@@ -291,11 +293,15 @@ void print_summary(const json& s, std::ostream& out) {
       << " non-converged, " << r["singular_systems"].get<std::uint64_t>() << " singular (failed), "
       << r["redundant_systems"].get<std::uint64_t>() << " redundant contact sets (minimum-norm), "
       << r["energy_gain_events"].get<std::uint64_t>() << " energy gains, max residual "
-      << r["max_residual_m_per_s"].get<double>() << " m/s\n"
-      << "friction              " << s["friction"]["sticking_contacts"].get<std::uint64_t>() << " sticking and "
-      << s["friction"]["sliding_contacts"].get<std::uint64_t>() << " sliding contacts (summed over steps), "
-      << s["friction"]["dissipated_j"].get<double>() << " J dissipated, max natural-map residual "
-      << r["max_natural_map_residual"].get<double>() << "\n";
+      << r["max_residual_m_per_s"].get<double>() << " m/s\n";
+  // Without friction the stick/slide counts only say whether a contact's tangential velocity was zero.
+  if (s["friction"].value("modelled", true))
+    out << "friction              " << s["friction"]["sticking_contacts"].get<std::uint64_t>() << " sticking and "
+        << s["friction"]["sliding_contacts"].get<std::uint64_t>() << " sliding contacts (summed over steps), "
+        << s["friction"]["dissipated_j"].get<double>() << " J dissipated, max natural-map residual "
+        << r["max_natural_map_residual"].get<double>() << "\n";
+  else
+    out << "friction              none: every body has friction 0, so contacts slide freely\n";
   print_energy(s["energy"], out);
   out << "momentum              from fixed bodies: linear " << norm("fixed_body_impulse_n_s") << " N s, angular "
       << norm("fixed_body_moment_n_m_s") << " N m s; drift (unexplained): linear "

@@ -390,6 +390,20 @@ TEST(CliSummary, WorkOfMovingFixedBodiesIsReportedNotFlagged) {
   EXPECT_NE(text.out.find("J work of moving fixed bodies"), std::string::npos) << text.out;
 }
 
+// The friction line says "none" where no body has friction (drop.yaml): its stick/slide counts would
+// only tell which frictionless contacts had no tangential velocity. With friction (slope.yaml) it counts
+// sliding contacts and the energy friction dissipated (> 0 for a box sliding 1 s).
+TEST(CliSummary, FrictionLineSaysNoneWithoutFriction) {
+  const Result frictionless = run("run " + scene("drop.yaml") + " --steps 600");
+  EXPECT_NE(frictionless.out.find("friction              none"), std::string::npos) << frictionless.out;
+  const auto j = nlohmann::json::parse(run("run " + scene("drop.yaml") + " --steps 600 --json").out);
+  EXPECT_FALSE(j["friction"]["modelled"].get<bool>());
+  const auto js = nlohmann::json::parse(run("run " + scene("slope.yaml") + " --duration 1 --json").out);
+  EXPECT_TRUE(js["friction"]["modelled"].get<bool>());
+  EXPECT_GT(js["friction"]["sliding_contacts"].get<std::uint64_t>(), 0u);
+  EXPECT_GT(js["friction"]["dissipated_j"].get<double>(), 0.0);
+}
+
 // A box resting flat on four corners: redundant contact sets solved by minimum norm, none singular,
 // and the summary says so in those words.
 TEST(CliSummary, RestingBoxReportsRedundantContactSetsNotSingular) {
