@@ -105,7 +105,8 @@ struct RunCounters {
   unsigned long long rounds = 0;            ///< resolver rounds or single impulses, all steps
   unsigned long long max_rounds_step = 0;   ///< the most in one step
   unsigned long long non_converged = 0;     ///< islands that hit the cap, all steps
-  unsigned long long singular_systems = 0;
+  unsigned long long singular_systems = 0;   ///< systems the resolver could not satisfy (failures)
+  unsigned long long redundant_systems = 0;  ///< redundant contact sets solved by minimum norm (normal)
   unsigned long long pulling_impulses = 0;
   unsigned long long nan_caught = 0;        ///< resolver and world
   unsigned long long energy_gain_events = 0;

@@ -40,6 +40,7 @@ nlohmann::json result_to_json(const RunResult& r) {
             {"max_rounds_per_step", c.max_rounds_step},
             {"non_converged", c.non_converged},
             {"singular_systems", c.singular_systems},
+            {"redundant_systems", c.redundant_systems},
             {"pulling_impulses", c.pulling_impulses},
             {"nan_caught", c.nan_caught},
             {"energy_gain_events", c.energy_gain_events},
@@ -61,6 +62,7 @@ RunResult result_from_json(const nlohmann::json& j) {
   r.counters.max_rounds_step = c.at("max_rounds_per_step").get<unsigned long long>();
   r.counters.non_converged = c.at("non_converged").get<unsigned long long>();
   r.counters.singular_systems = c.at("singular_systems").get<unsigned long long>();
+  r.counters.redundant_systems = c.value("redundant_systems", 0ull);  // absent from files before ABI 5
   r.counters.pulling_impulses = c.at("pulling_impulses").get<unsigned long long>();
   r.counters.nan_caught = c.at("nan_caught").get<unsigned long long>();
   r.counters.energy_gain_events = c.at("energy_gain_events").get<unsigned long long>();

@@ -32,6 +32,7 @@ void count(RunCounters& c, const StepStatus& status) {
   c.max_rounds_step = std::max<unsigned long long>(c.max_rounds_step, r.rounds);
   c.non_converged += r.non_converged;
   c.singular_systems += r.singular_systems;
+  c.redundant_systems += r.redundant_systems;
   c.pulling_impulses += r.pulling_impulses;
   c.nan_caught += r.nan_caught + status.nan_caught;
   c.energy_gain_events += r.energy_gain_events;
