@@ -18,6 +18,9 @@
 //   start_set     one sphere pyramid K = 20 on the fixed ground, the paper's drop velocities: the ledas
 //                 search starts with the impact's contacts (on, `start_set: impact`) or with every
 //                 touching contact (off, `start_set: touching`): the same answer, another first guess.
+//   sleep         1,000 unit boxes in 100 stacks of 10 resting on the fixed ground, settled for 0.2 s
+//                 first, with sleeping islands (on: every stack asleep after 0.1 s still) or without
+//                 (off): a sleeping scene costs no detection or resolution. Counter `sleeping`.
 #include "support/bench_main.hpp"
 #include "support/bench_steps.hpp"
 
@@ -80,6 +83,19 @@ std::string scene_text(const std::string& lever, bool on) {
     // with either shape.
     return header("[0, 0, -9.81]", "{plugin: fcl, margin: 5.0e-3}", "ledas") + fixed_ground + pyramids(1, 10, shape);
   }
+  if (lever == "sleep") {
+    std::ostringstream out;
+    out.precision(17);
+    out << "dt: 0.001\ngravity: [0, 0, -9.81]\nsleep: {enabled: " << (on ? "true" : "false")
+        << ", time: 0.1}\nmodules:\n  integrator: momentum\n  detector: {plugin: fcl, margin: 1.0e-3}\n"
+           "  resolver: ledas\nbodies:\n"
+        << fixed_ground;
+    for (int stack = 0; stack < 100; ++stack)
+      for (int level = 0; level < 10; ++level)
+        out << "  - {name: b" << stack << "_" << level << ", shape: {box: {size: [1, 1, 1]}}, mass: 1, position: ["
+            << 2.0 * (stack % 10) << ", " << 2.0 * (stack / 10) << ", " << 0.49999 + 0.99999 * level << "]}\n";
+    return out.str();
+  }
   // contact_reduction
   std::ostringstream out;
   out.precision(17);
@@ -104,6 +120,8 @@ void model(benchmark::State& state, const std::string& lever, bool on) {
     state.SkipWithError(e.what());
     return;
   }
+  if (lever == "sleep")  // settle first (both rows alike), so that the timed steps are the settled scene's
+    for (int i = 0; i < 200; ++i) world->step();
   const std::vector<RigidBody> initial(world->bodies().begin(), world->bodies().end());
   const auto [sum, last, cold_ms] = bench::time_steps(state, *world, initial);
   const auto per_step = benchmark::Counter::kAvgIterations;
@@ -112,13 +130,14 @@ void model(benchmark::State& state, const std::string& lever, bool on) {
   state.counters["rows_solved"] = static_cast<double>(last.resolver.contacts);
   state.counters["islands"] = static_cast<double>(last.resolver.islands);
   state.counters["residual"] = last.resolver.residual;
+  state.counters["sleeping"] = static_cast<double>(last.sleeping_bodies);
   state.counters["cold_ms"] = cold_ms;
   state.counters["detect_ms"] = benchmark::Counter(1e3 * sum.detect, per_step);
   state.counters["resolve_ms"] = benchmark::Counter(1e3 * sum.resolve, per_step);
 }
 
 int register_all() {
-  for (const std::string lever : {"fixed_bodies", "islands", "primitives", "contact_reduction", "start_set"})
+  for (const std::string lever : {"fixed_bodies", "islands", "primitives", "contact_reduction", "start_set", "sleep"})
     for (const bool on : {true, false})
       benchmark::RegisterBenchmark(("model/" + lever + (on ? "/on" : "/off")).c_str(),
                                    [lever, on](benchmark::State& st) { model(st, lever, on); })

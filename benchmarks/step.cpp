@@ -59,7 +59,8 @@ void step(benchmark::State& state, const std::string& resolver_name, Scene scene
       : scene == Scene::line  ? make_line(LineParams{.count = n, .restitution = restitution})
       : scene == Scene::stack ? make_stack(n, 0.5)
                               : make_pyramid(PyramidParams{.rows = n, .velocity = Vec3::Zero(), .friction = 0.7});
-  World world(WorldSettings{.dt = 1e-3, .gravity = Vec3(0, 0, -9.81)});
+  WorldSettings settings;  // dt 1 ms, gravity −9.81 m/s² along z
+  World world(settings);
   for (const RigidBody& b : initial) world.add_body(b);
   world.set_integrator(std::make_shared<MomentumIntegrator>(ModuleOptions{}));
   world.set_detector(std::make_shared<FclDetector>());

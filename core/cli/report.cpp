@@ -105,6 +105,9 @@ void RunStats::add_step(const World& world, const StepStatus& status) {
   contact_energy_scale_ += std::abs(status.resolve_kinetic_energy_change);
   correction_energy_ += status.resolve_potential_energy_change;
   prescribed_work_ += status.prescribed_work;
+  sleeping_now_ = status.sleeping_bodies;
+  max_sleeping_ = std::max(max_sleeping_, status.sleeping_bodies);
+  woken_ += status.woken_bodies;
   add_fixed_body_impulses(world);
   // Loads without a potential: torques and body-frame forces, dt (F·v + τ·ω) per step.
   double step_load_work = 0.0;
@@ -217,6 +220,11 @@ json RunStats::summary(const World& world, double wall_seconds) const {
        {{"modelled", frictional_},
         {"sticking_contacts", sticking_}, {"sliding_contacts", sliding_},
         {"dissipated_j", 0.0 - friction_work_}}},
+      {"sleep",
+       {{"enabled", world.settings().sleep.enabled},
+        {"sleeping_final", sleeping_now_},
+        {"max_sleeping", max_sleeping_},
+        {"woken", woken_}}},
       {"energy", energy_summary(world)},
       {"momentum", momentum},
       // The change gravity, applied loads and fixed bodies' impulses do not explain (README.md).
@@ -302,6 +310,10 @@ void print_summary(const json& s, std::ostream& out) {
         << r["max_natural_map_residual"].get<double>() << "\n";
   else
     out << "friction              none: every body has friction 0, so contacts slide freely\n";
+  if (s.contains("sleep") && s["sleep"]["enabled"].get<bool>())
+    out << "sleeping              " << s["sleep"]["sleeping_final"].get<std::uint64_t>() << " bodies asleep at the end (at most "
+        << s["sleep"]["max_sleeping"].get<std::uint64_t>() << "), " << s["sleep"]["woken"].get<std::uint64_t>()
+        << " woken up\n";
   print_energy(s["energy"], out);
   out << "momentum              from fixed bodies: linear " << norm("fixed_body_impulse_n_s") << " N s, angular "
       << norm("fixed_body_moment_n_m_s") << " N m s; drift (unexplained): linear "

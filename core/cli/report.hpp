@@ -43,7 +43,8 @@ class RunStats {
   WorldMetrics initial_;
   std::vector<Vec3> initial_positions_;  // of every body, for the work of gravity and constant forces
   double total_mass_ = 0.0;
-  bool frictional_ = false;              // some body has friction > 0 (else every contact is frictionless)
+  bool frictional_ = false;
+  std::uint64_t sleeping_now_ = 0, max_sleeping_ = 0, woken_ = 0;  // sleeping islands              // some body has friction > 0 (else every contact is frictionless)
   Vec3 gravity_impulse_ = Vec3::Zero();  // ∫ Σ m g dt: the linear momentum gravity adds
   Vec3 gravity_moment_ = Vec3::Zero();   // ∫ Σ x × m g dt: the angular momentum gravity adds about 0
   Vec3 load_impulse_ = Vec3::Zero();     // ∫ Σ F dt: the linear momentum applied forces add

@@ -29,6 +29,10 @@ double seconds(Clock::time_point from, Clock::time_point to) {
 
 std::uint64_t pair_key(BodyIndex a, BodyIndex b) { return (static_cast<std::uint64_t>(a) << 32) | b; }
 
+// Sleeping islands: a pair of two quiet bodies (asleep, or fixed with no motion) can change nothing and
+// is not tested. Any other body touching a sleeping one is reported, so the world can wake it.
+bool quiet(const RigidBody& body) { return body.asleep || (body.fixed && body.motion == PrescribedMotion::none); }
+
 bool is_rounded(ShapeKind k) { return k == ShapeKind::sphere || k == ShapeKind::capsule; }
 
 bool overlap(const Aabb& x, const Aabb& y) {
@@ -191,7 +195,14 @@ void FclDetector::detect(std::span<const RigidBody> bodies, const StepContext& /
   // margin still overlaps), traverse the trees (fattened boxes: a superset), test the planes, keep the
   // pairs whose exact boxes overlap and that pass the filters, sort.
   s.pairs.clear();
+  // A scene asleep to the last body (and no fixed body moving) has nothing to detect.
+  if (std::all_of(s.movable.begin(), s.movable.end(), [&](BodyIndex i) { return quiet(bodies[i]); }) &&
+      std::all_of(s.planes.begin(), s.planes.end(), [&](BodyIndex i) { return quiet(bodies[i]); })) {
+    s.profile.broadphase = seconds(start, Clock::now());
+    return;
+  }
   for (BodyIndex i : s.movable) {
+    if (bodies[i].asleep) continue;  // it has not moved since it fell asleep
     const Placed body = s.placed(bodies[i], i);
     if (!body.x.allFinite() || !body.R.allFinite()) continue;  // the world rolls such a state back
     s.boxes[i] = grown(world_aabb(body), 0.5 * margin);
@@ -200,7 +211,9 @@ void FclDetector::detect(std::span<const RigidBody> bodies, const StepContext& /
   s.broadphase.collect(s.pairs);
   for (BodyIndex p : s.planes) {
     const WorldPlane plane = world_plane(s.placed(bodies[p], p));
+    const bool plane_quiet = quiet(bodies[p]);
     for (BodyIndex i : s.movable) {
+      if (plane_quiet && quiet(bodies[i])) continue;
       const Vec3 center = 0.5 * (s.boxes[i].min + s.boxes[i].max), half = 0.5 * (s.boxes[i].max - s.boxes[i].min);
       if (plane.normal.dot(center) - plane.normal.cwiseAbs().dot(half) <= plane.offset + 0.5 * margin)
         s.pairs.emplace_back(std::min(i, p), std::max(i, p));
@@ -210,7 +223,8 @@ void FclDetector::detect(std::span<const RigidBody> bodies, const StepContext& /
   std::erase_if(s.pairs, [&](const BodyPair& p) {
     const bool planar =
         s.bodies[p.first].geometry.kind == ShapeKind::plane || s.bodies[p.second].geometry.kind == ShapeKind::plane;
-    return (!planar && !overlap(s.boxes[p.first], s.boxes[p.second])) || s.filtered(p.first, p.second);
+    return (!planar && !overlap(s.boxes[p.first], s.boxes[p.second])) || s.filtered(p.first, p.second) ||
+           (quiet(bodies[p.first]) && quiet(bodies[p.second]));
   });
   std::sort(s.pairs.begin(), s.pairs.end());
   const auto broad_end = Clock::now();

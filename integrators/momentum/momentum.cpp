@@ -10,13 +10,13 @@ void MomentumIntegrator::integrate_velocities(std::span<RigidBody> bodies, const
   // L += dt τ at the current R is ω += dt J_world⁻¹ τ: the shared update, without the round trip
   // through L (which would only add rounding).
   for (RigidBody& body : bodies)
-    if (!body.fixed) integrators::integrate_velocity(body, ctx);
+    if (!body.fixed && !body.asleep) integrators::integrate_velocity(body, ctx);
 }
 
 void MomentumIntegrator::integrate_positions(std::span<RigidBody> bodies, const StepContext& ctx,
                                              IntegratorCounters& counters) noexcept {
   for (RigidBody& body : bodies) {
-    if (body.fixed) continue;
+    if (body.fixed || body.asleep) continue;
     // Torque-free between the phases, L is constant in the world frame while J_world turns with the
     // body: this is where the gyroscopic term that eq. 2 drops comes back.
     // Products applied right to left (R (J (Rᵀ ω))) round less than forming J_world = R J Rᵀ.

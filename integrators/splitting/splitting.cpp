@@ -52,14 +52,14 @@ SplittingIntegrator::SplittingIntegrator(const ModuleOptions& options)
 void SplittingIntegrator::integrate_velocities(std::span<RigidBody> bodies, const StepContext& ctx,
                                                IntegratorCounters& /*counters*/) noexcept {
   for (RigidBody& body : bodies)
-    if (!body.fixed) integrators::integrate_velocity(body, ctx);
+    if (!body.fixed && !body.asleep) integrators::integrate_velocity(body, ctx);
 }
 
 void SplittingIntegrator::integrate_positions(std::span<RigidBody> bodies, const StepContext& ctx,
                                               IntegratorCounters& counters) noexcept {
   const double dt = ctx.dt;
   for (RigidBody& body : bodies) {
-    if (body.fixed) continue;
+    if (body.fixed || body.asleep) continue;
     // eq. (2), row 3, with the velocity already updated (and resolved): symplectic Euler.
     body.position += dt * body.velocity;
 

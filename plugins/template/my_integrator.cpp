@@ -20,7 +20,7 @@ class MyIntegrator final : public impetus::Integrator {
     // Implicit in the damping term, so any damping·dt is stable.
     const double keep = 1.0 / (1.0 + damping_ * ctx.dt);
     for (impetus::RigidBody& body : bodies) {
-      if (body.fixed) continue;
+      if (body.fixed || body.asleep) continue;
       body.velocity = keep * (body.velocity + ctx.dt * (ctx.gravity + body.inv_mass * body.applied_force()));
       body.angular_velocity =
           keep * (body.angular_velocity + ctx.dt * (body.inv_inertia_world() * body.applied_torque()));
@@ -31,7 +31,7 @@ class MyIntegrator final : public impetus::Integrator {
   void integrate_positions(std::span<impetus::RigidBody> bodies, const impetus::StepContext& ctx,
                            impetus::IntegratorCounters& counters) noexcept override {
     for (impetus::RigidBody& body : bodies) {
-      if (body.fixed) continue;
+      if (body.fixed || body.asleep) continue;
       body.position += ctx.dt * body.velocity;
       // Products of rotations drift from orthonormal; re-project every step (cheap).
       body.rotation = impetus::orthonormalized(

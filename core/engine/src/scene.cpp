@@ -45,13 +45,24 @@ Scene read_scene(const SceneReader& r, const YAML::Node& root) {
   if (!root.IsMap()) r.fail(root, "a scene is a mapping of keys (dt, gravity, modules, bodies, ...), got " +
                                       SceneReader::describe(root));
   const Fields f(r, root, "scene",
-                 {"dt", "gravity", "step_order", "plugin_path", "modules", "bodies", "generators", "constraints"});
+                 {"dt", "gravity", "step_order", "sleep", "plugin_path", "modules", "bodies", "generators",
+                  "constraints"});
   Scene scene;
   if (const YAML::Node* n = f.find("dt")) scene.settings.dt = r.positive(*n, "dt");
   if (const YAML::Node* n = f.find("gravity")) scene.settings.gravity = r.vec3(*n, "gravity");
   if (const YAML::Node* n = f.find("step_order"))
     scene.settings.order = r.choice(*n, "step_order", {"split", "paper"}) == "paper" ? StepOrder::paper
                                                                                      : StepOrder::split;
+  if (const YAML::Node* n = f.find("sleep")) {
+    // Sleeping islands (docs/conventions.md, "Sleeping"): `sleep: {enabled, linear_velocity,
+    // angular_velocity, time}`; any key given turns it on unless `enabled: false`.
+    const Fields s(r, *n, "sleep", {"enabled", "linear_velocity", "angular_velocity", "time"});
+    SleepSettings& sleep = scene.settings.sleep;
+    sleep.enabled = s.find("enabled") ? r.boolean(*s.find("enabled"), "enabled") : true;
+    if (const YAML::Node* v = s.find("linear_velocity")) sleep.linear_velocity = r.non_negative(*v, "linear_velocity");
+    if (const YAML::Node* v = s.find("angular_velocity")) sleep.angular_velocity = r.non_negative(*v, "angular_velocity");
+    if (const YAML::Node* v = s.find("time")) sleep.time = r.positive(*v, "time");
+  }
   if (const YAML::Node* n = f.find("plugin_path")) {
     // One directory or a list of them, relative to the scene file.
     const std::vector<YAML::Node> dirs = n->IsSequence() ? r.list(*n, "plugin_path") : std::vector{*n};

@@ -111,6 +111,13 @@ World::World(WorldSettings settings) : settings_(std::move(settings)) {
   if (!(settings_.dt > 0.0) || !std::isfinite(settings_.dt))
     throw Error("world: dt must be positive and finite, got " + std::to_string(settings_.dt));
   if (!all_finite(settings_.gravity)) throw Error("world: gravity must be finite");
+  const SleepSettings& sleep = settings_.sleep;
+  if (!(sleep.linear_velocity >= 0.0) || !std::isfinite(sleep.linear_velocity))
+    throw Error("world: sleep linear_velocity must be finite and >= 0, got " + std::to_string(sleep.linear_velocity));
+  if (!(sleep.angular_velocity >= 0.0) || !std::isfinite(sleep.angular_velocity))
+    throw Error("world: sleep angular_velocity must be finite and >= 0, got " + std::to_string(sleep.angular_velocity));
+  if (!(sleep.time > 0.0) || !std::isfinite(sleep.time))
+    throw Error("world: sleep time must be positive and finite, got " + std::to_string(sleep.time));
 }
 
 World::~World() = default;
@@ -120,9 +127,12 @@ BodyIndex World::add_body(RigidBody body) {
   if (!body.name.empty() && find_body(body.name))
     throw Error("body '" + body.name + "': a body with this name already exists");
   if (resolver_) check_friction(*resolver_, body, bodies_.size());
+  if (body.asleep) throw Error(body_label(body, bodies_.size()) + ": 'asleep' is the world's to set; add bodies awake");
   if (body.fixed) make_fixed(body);
   bodies_.push_back(std::move(body));
   handles_.push_back(BodyHandle{next_handle_++});
+  still_time_.push_back(0.0);
+  sleep_group_.push_back(static_cast<std::uint32_t>(bodies_.size() - 1));
   detector_stale_ = true;
   return static_cast<BodyIndex>(bodies_.size() - 1);
 }
@@ -155,6 +165,7 @@ std::size_t World::remove_body(const std::string& name) {
 }
 
 std::size_t World::remove_at(BodyIndex index) {
+  if (bodies_[index].asleep) wake_group(sleep_group_[index], nullptr);  // its neighbours lose its support
   std::vector<std::int64_t> new_index(bodies_.size());
   for (std::size_t i = 0; i < bodies_.size(); ++i)
     new_index[i] = i < index ? static_cast<std::int64_t>(i) : i == index ? -1 : static_cast<std::int64_t>(i) - 1;
@@ -172,6 +183,10 @@ std::size_t World::remove_at(BodyIndex index) {
         constraint);
   bodies_.erase(bodies_.begin() + index);
   handles_.erase(handles_.begin() + index);
+  still_time_.erase(still_time_.begin() + index);
+  sleep_group_.erase(sleep_group_.begin() + index);
+  for (std::uint32_t& group : sleep_group_)  // a group is named by its lowest body, never the removed one now
+    if (new_index[group] >= 0) group = static_cast<std::uint32_t>(new_index[group]);
   contacts_.clear();  // they name bodies by their old indices
   detector_stale_ = true;
   if (resolver_) resolver_->bodies_removed(new_index);
@@ -240,6 +255,21 @@ void World::detect(StepStatus& status) {
   if (detector_) {
     sync_detector();
     detector_->detect(bodies_, context(), contacts_, status.detector);
+    if (settings_.sleep.enabled) {
+      // Touching a sleeping group wakes it; its own contacts were skipped while it slept, so detect again
+      // (until no more groups wake: a woken group may touch another).
+      woken_now_.clear();
+      while (wake_touched(status)) {
+        contacts_.clear();
+        detector_->detect(bodies_, context(), contacts_, status.detector);
+      }
+      if (stepping_ && !woken_now_.empty()) kick_woken(status);
+      // Whatever detector is in use, contacts between quiet bodies (asleep, or fixed at rest) go nowhere.
+      std::erase_if(contacts_, [&](const Contact& c) {
+        const auto quiet = [](const RigidBody& b) { return b.asleep || (b.fixed && b.motion == PrescribedMotion::none); };
+        return quiet(bodies_[c.a]) && quiet(bodies_[c.b]);
+      });
+    }
   }
   status.profile.detect = seconds_since(start);
 }
@@ -315,8 +345,15 @@ const StepStatus& World::step() {
     if (const char* why = motion_problem(bodies_[i])) throw Error(body_label(bodies_[i], i) + ": " + why);
   const auto start = Clock::now();
   status_ = StepStatus{};
+  // A sleeping body the program gave a velocity or a load wakes with its group.
+  for (std::size_t i = 0; i < bodies_.size(); ++i) {
+    const RigidBody& b = bodies_[i];
+    if (b.asleep && (!b.velocity.isZero(0.0) || !b.angular_velocity.isZero(0.0) || b.loaded()))
+      wake_group(sleep_group_[i], &status_);
+  }
   take_snapshot();
   const StepContext ctx = context();
+  stepping_ = true;
   const auto timed = [](double& slot, auto&& stage) {
     const auto t0 = Clock::now();
     stage();
@@ -325,8 +362,11 @@ const StepStatus& World::step() {
 
   bool ok = true;
   if (settings_.order == StepOrder::split) {
-    // 1. velocities: gravity and applied loads over dt
-    timed(status_.profile.velocities, [&] { integrator_->integrate_velocities(bodies_, ctx, status_.integrator); });
+    // 1. velocities: gravity and applied loads over dt (sleeping bodies keep zero)
+    timed(status_.profile.velocities, [&] {
+      integrator_->integrate_velocities(bodies_, ctx, status_.integrator);
+      hold_sleepers();
+    });
     ok = check_finite(status_, "velocity integration");
     // 2. detect contacts at the current positions
     if (ok) detect(status_);
@@ -345,7 +385,10 @@ const StepStatus& World::step() {
     }
   } else {
     // The paper's order (sec. 2): integrate fully, then detect and resolve at the new positions.
-    timed(status_.profile.velocities, [&] { integrator_->integrate_velocities(bodies_, ctx, status_.integrator); });
+    timed(status_.profile.velocities, [&] {
+      integrator_->integrate_velocities(bodies_, ctx, status_.integrator);
+      hold_sleepers();
+    });
     timed(status_.profile.positions, [&] {
       integrator_->integrate_positions(bodies_, ctx, status_.integrator);
       move_prescribed();
@@ -361,9 +404,128 @@ const StepStatus& World::step() {
   if (ok) {
     ++step_count_;
     time_ = static_cast<double>(step_count_) * settings_.dt;  // no accumulated rounding in time
+    if (settings_.sleep.enabled) settle();
   }
+  stepping_ = false;
+  for (const RigidBody& b : bodies_)
+    if (!b.fixed) ++(b.asleep ? status_.sleeping_bodies : status_.awake_bodies);
   status_.profile.total = seconds_since(start);
   return status_;
+}
+
+// Sleeping bodies keep zero velocities: the velocity stage's kick from gravity is taken back before
+// anything sees it, so their poses do not change.
+void World::hold_sleepers() {
+  if (!settings_.sleep.enabled) return;
+  for (RigidBody& b : bodies_)
+    if (b.asleep) {
+      b.velocity.setZero();
+      b.angular_velocity.setZero();
+    }
+}
+
+// Bodies woken by this step's detection slept through its velocity stage: they get it now, from the
+// integrator itself (its velocity phase is per body), so that they feel this step's gravity and loads
+// exactly as if they had been awake.
+void World::kick_woken(StepStatus& status) {
+  std::vector<RigidBody> woken;
+  woken.reserve(woken_now_.size());
+  for (BodyIndex i : woken_now_) woken.push_back(bodies_[i]);
+  integrator_->integrate_velocities(woken, context(), status.integrator);
+  for (std::size_t k = 0; k < woken_now_.size(); ++k) {
+    bodies_[woken_now_[k]].velocity = woken[k].velocity;
+    bodies_[woken_now_[k]].angular_velocity = woken[k].angular_velocity;
+  }
+}
+
+void World::wake(BodyIndex index) {
+  if (index >= bodies_.size())
+    throw Error("world: no body has index " + std::to_string(index) + " (there are " +
+                std::to_string(bodies_.size()) + ")");
+  if (bodies_[index].asleep) wake_group(sleep_group_[index], nullptr);
+}
+
+void World::wake_group(std::uint32_t group, StepStatus* status) {
+  for (std::size_t i = 0; i < bodies_.size(); ++i)
+    if (bodies_[i].asleep && sleep_group_[i] == group) {
+      bodies_[i].asleep = false;
+      still_time_[i] = 0.0;  // it must be still for the whole time again before it sleeps
+      if (status) {
+        ++status->woken_bodies;
+        woken_now_.push_back(static_cast<BodyIndex>(i));
+      }
+    }
+}
+
+// After a detection: wakes every sleeping group something that is not quiet touches (an awake movable
+// body, a fixed body with a prescribed motion) or that a constraint joins to an awake body. True if any
+// woke (their own contacts were not detected while they slept: the caller detects again).
+bool World::wake_touched(StepStatus& status) {
+  const std::uint64_t before = status.woken_bodies;
+  const auto active = [](const RigidBody& b) { return !b.asleep && !(b.fixed && b.motion == PrescribedMotion::none); };
+  for (const Contact& c : contacts_) {
+    if (bodies_[c.a].asleep && active(bodies_[c.b])) wake_group(sleep_group_[c.a], &status);
+    if (bodies_[c.b].asleep && active(bodies_[c.a])) wake_group(sleep_group_[c.b], &status);
+  }
+  for (const Constraint& constraint : constraints_) {
+    const ConstraintEnds pp = ends_of(constraint);
+    if (bodies_[pp.a].asleep && active(bodies_[pp.b])) wake_group(sleep_group_[pp.a], &status);
+    if (bodies_[pp.b].asleep && active(bodies_[pp.a])) wake_group(sleep_group_[pp.b], &status);
+  }
+  return status.woken_bodies != before;
+}
+
+// End of a step: each awake movable body's still time grows while it is slower than the thresholds. The
+// awake bodies joined by this step's contacts and constraints form groups; a group falls asleep when all
+// its bodies have been still for settings().sleep.time, none carries a load and none touches a fixed body
+// that moves (a belt keeps what it carries awake). Union-find over body indices: deterministic.
+void World::settle() {
+  if (std::all_of(bodies_.begin(), bodies_.end(), [](const RigidBody& b) { return b.fixed || b.asleep; })) return;
+  const SleepSettings& sleep = settings_.sleep;
+  const double v2 = sleep.linear_velocity * sleep.linear_velocity, w2 = sleep.angular_velocity * sleep.angular_velocity;
+  const std::size_t n = bodies_.size();
+  std::vector<std::uint32_t> parent(n);
+  for (std::size_t i = 0; i < n; ++i) parent[i] = static_cast<std::uint32_t>(i);
+  const auto root = [&](std::uint32_t i) {
+    while (parent[i] != i) i = parent[i] = parent[parent[i]];
+    return i;
+  };
+  const auto join = [&](BodyIndex a, BodyIndex b) {
+    if (bodies_[a].fixed || bodies_[b].fixed) return;  // fixed bodies do not connect groups
+    const std::uint32_t ra = root(a), rb = root(b);
+    if (ra != rb) parent[std::max(ra, rb)] = std::min(ra, rb);  // the root is the group's lowest index
+  };
+  std::vector<char> restless(n, 0);  // a group with one of these never sleeps
+  for (std::size_t i = 0; i < n; ++i) {
+    RigidBody& b = bodies_[i];
+    if (b.fixed || b.asleep) continue;
+    const bool still = b.velocity.squaredNorm() <= v2 && b.angular_velocity.squaredNorm() <= w2;
+    still_time_[i] = still ? still_time_[i] + settings_.dt : 0.0;
+    restless[i] = still_time_[i] < sleep.time || b.loaded();
+  }
+  for (const Contact& c : contacts_) {
+    join(c.a, c.b);
+    const RigidBody &a = bodies_[c.a], &b = bodies_[c.b];
+    if (a.fixed && a.motion != PrescribedMotion::none) restless[c.b] = 1;
+    if (b.fixed && b.motion != PrescribedMotion::none) restless[c.a] = 1;
+  }
+  for (const Constraint& constraint : constraints_) {
+    const ConstraintEnds pp = ends_of(constraint);
+    join(pp.a, pp.b);
+  }
+  std::vector<char> group_restless(n, 0);
+  for (std::size_t i = 0; i < n; ++i)
+    if (!bodies_[i].fixed && !bodies_[i].asleep && restless[i]) group_restless[root(static_cast<std::uint32_t>(i))] = 1;
+  for (std::size_t i = 0; i < n; ++i) {
+    RigidBody& b = bodies_[i];
+    if (b.fixed || b.asleep) continue;
+    const std::uint32_t group = root(static_cast<std::uint32_t>(i));
+    if (group_restless[group]) continue;
+    b.asleep = true;
+    b.velocity.setZero();
+    b.angular_velocity.setZero();
+    sleep_group_[i] = group;
+  }
 }
 
 const StepStatus& World::detect_and_resolve() {

@@ -65,6 +65,10 @@ struct RigidBody {
   Mat3 rotation = Mat3::Identity();      ///< body → world
   Vec3 velocity = Vec3::Zero();          ///< of the center of mass, world frame (m/s)
   Vec3 angular_velocity = Vec3::Zero();  ///< world frame (rad/s)
+  /// Asleep (movable bodies only; World's sleeping islands, docs/conventions.md "Sleeping"): at rest with
+  /// zero velocities, not integrated, and no contact between two sleeping or fixed-at-rest bodies is
+  /// detected or resolved. Set and cleared by the world.
+  bool asleep = false;
 
   // --- applied loads (movable bodies only; persistent until changed; gravity is added separately) ---
   Vec3 force = Vec3::Zero();        ///< N, world frame, through the center of mass

@@ -11,7 +11,8 @@
 namespace impetus {
 
 /// Advances the bodies' state in time. Implementations skip fixed bodies (the world moves those with a
-/// prescribed motion itself) and apply RigidBody::applied_force() and applied_torque().
+/// prescribed motion itself) and sleeping ones (RigidBody::asleep), and apply RigidBody::applied_force()
+/// and applied_torque().
 class Integrator {
  public:
   virtual ~Integrator() = default;

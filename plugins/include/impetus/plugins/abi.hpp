@@ -28,8 +28,8 @@ class ModuleOptions;
 /// 5: ResolverCounters::redundant_systems (redundant contact sets solved by minimum norm, told apart from
 /// singular_systems, which now counts only real failures).
 /// 6: applied loads in the body frame and prescribed motion of fixed bodies (RigidBody::force_body,
-/// torque_body, motion); CollisionResolver::bodies_removed.
-inline constexpr std::uint32_t kPluginAbiVersion = 6;
+/// torque_body, motion); CollisionResolver::bodies_removed. 7: RigidBody::asleep (sleeping islands).
+inline constexpr std::uint32_t kPluginAbiVersion = 7;
 
 /// Name of the entry symbol every plugin exports.
 inline constexpr const char* kPluginEntrySymbol = "impetus_plugin_descriptor";

@@ -28,11 +28,23 @@ enum class StepOrder : std::uint8_t {
   paper
 };
 
+/// Sleeping islands (docs/conventions.md, "Sleeping"): a group of movable bodies joined by contacts and
+/// constraints whose every body has moved slower than the thresholds for `time` goes to sleep: its
+/// velocities are set to zero and it costs no integration, detection or resolution until something
+/// touches it, a load or velocity is given to one of its bodies, or the program wakes it.
+struct SleepSettings {
+  bool enabled = false;            ///< off by default: a scene opts in (`sleep: {enabled: true}`)
+  double linear_velocity = 0.01;   ///< m/s: a body is still below this speed …
+  double angular_velocity = 0.05;  ///< rad/s: … and this spin
+  double time = 0.5;               ///< s: how long every body of a group must have been still
+};
+
 /// World-wide settings (the configuration part of a scene).
 struct WorldSettings {
   double dt = 1e-3;                       ///< time step (s), > 0
   Vec3 gravity{0.0, 0.0, -9.81};          ///< m/s²
   StepOrder order = StepOrder::split;
+  SleepSettings sleep;
 };
 
 /// Wall time of each stage of one step (seconds, steady clock).
@@ -61,6 +73,9 @@ struct StepStatus {
   /// over their contacts with movable bodies (J): energy such a body puts in (a pusher) or takes out. It is
   /// part of resolve_kinetic_energy_change, so the contacts' own dissipation is that change minus this.
   double prescribed_work = 0.0;
+  std::uint64_t awake_bodies = 0;     ///< movable bodies awake at the end of the step
+  std::uint64_t sleeping_bodies = 0;  ///< movable bodies asleep at the end of the step
+  std::uint64_t woken_bodies = 0;     ///< bodies woken during the step
   std::uint64_t nan_caught = 0;  ///< bodies whose state became non-finite (restored to before the step)
   bool ok = true;                ///< false when anything non-finite was caught
   std::string message;           ///< why not ok, naming the body and the stage
@@ -97,6 +112,9 @@ class World {
   BodyHandle handle(BodyIndex index) const;
   /// The current index of the body with `handle`, if it is still in the world.
   std::optional<BodyIndex> index_of(BodyHandle handle) const;
+  /// Wakes the sleeping group of the body at `index` (nothing if it is awake or fixed). A program that
+  /// moves a sleeping body's pose should call it; a velocity or load given to one wakes it by itself.
+  void wake(BodyIndex index);
   /// Adds a constraint between two existing bodies. Throws Error for a bad index.
   void add_constraint(Constraint constraint);
 
@@ -143,6 +161,11 @@ class World {
   void take_snapshot();
   void restore_snapshot();
   void move_prescribed();
+  bool wake_touched(StepStatus& status);
+  void wake_group(std::uint32_t group, StepStatus* status);
+  void settle();
+  void kick_woken(StepStatus& status);
+  void hold_sleepers();
   std::size_t remove_at(BodyIndex index);
 
   struct BodyState {
@@ -156,6 +179,12 @@ class World {
   std::vector<RigidBody> bodies_;
   std::vector<BodyHandle> handles_;  // per body, increasing (removal keeps the order)
   std::uint64_t next_handle_ = 1;
+  // Sleeping islands: per body, how long it has been still (s) and its sleeping group (the lowest index
+  // of the group it fell asleep with; meaningless while awake).
+  std::vector<double> still_time_;
+  std::vector<std::uint32_t> sleep_group_;
+  std::vector<BodyIndex> woken_now_;  // woken by the current detection (they missed its velocity stage)
+  bool stepping_ = false;             // inside step() (detect() is also called by detect_and_resolve())
   std::vector<Constraint> constraints_;
   std::vector<Contact> contacts_;
   std::vector<BodyState> snapshot_;  // state before the step, for rollback on NaN
