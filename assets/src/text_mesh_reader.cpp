@@ -40,6 +40,11 @@ constexpr std::uint64_t kMaxVertices = std::numeric_limits<std::uint32_t>::max()
 
 bool is_space(char c) { return c == ' ' || c == '\t' || c == '\r' || c == '\v' || c == '\f'; }
 
+// A leading '+' that from_chars would refuse, before a digit or '.' (so "+-1" stays refused).
+bool plus_sign(std::string_view token) {
+  return token.size() > 1 && token[0] == '+' && token[1] != '+' && token[1] != '-';
+}
+
 std::string quoted(std::string_view token) {
   constexpr std::size_t kShown = 40;
   return "'" + std::string(token.substr(0, kShown)) + (token.size() > kShown ? "…'" : "'");
@@ -71,7 +76,7 @@ class Source {
 
   double real(std::string_view token, const char* what) const {
     std::string_view digits = token;
-    if (digits.size() > 1 && digits[0] == '+') digits.remove_prefix(1);  // from_chars takes no '+'
+    if (plus_sign(digits)) digits.remove_prefix(1);  // from_chars takes no '+'
     double value = 0.0;
     const auto [end, ec] = std::from_chars(digits.data(), digits.data() + digits.size(), value);
     if (ec == std::errc::result_out_of_range)
@@ -83,7 +88,7 @@ class Source {
 
   std::int64_t integer(std::string_view token, const char* what) const {
     std::string_view digits = token;
-    if (digits.size() > 1 && digits[0] == '+') digits.remove_prefix(1);
+    if (plus_sign(digits)) digits.remove_prefix(1);
     std::int64_t value = 0;
     const auto [end, ec] = std::from_chars(digits.data(), digits.data() + digits.size(), value);
     if (ec != std::errc{} || end != digits.data() + digits.size())
@@ -264,9 +269,10 @@ ImportedMesh read_ascii_stl(const std::filesystem::path& file, std::string text,
   while (source.next_line(line)) {
     const std::vector<std::string_view> w = words(line, '\0');
     if (w.empty()) continue;
-    const std::string_view keyword = w[0];
+    // Keywords in any case, as some older exporters write them in capitals.
+    const std::string keyword = lower(std::string(w[0]));
     const auto expect = [&](State wanted, const char* where) {
-      if (state != wanted) source.fail(quoted(keyword) + " " + where);
+      if (state != wanted) source.fail(quoted(w[0]) + " " + where);
     };
     if (keyword == "solid") {
       expect(State::outside, "inside a solid (no 'endsolid' before it)");
@@ -276,12 +282,12 @@ ImportedMesh read_ascii_stl(const std::filesystem::path& file, std::string text,
       state = State::solid;
     } else if (keyword == "facet") {
       expect(State::solid, "outside a solid or inside a facet");
-      if (w.size() != 5 || w[1] != "normal") source.fail("expected 'facet normal nx ny nz'");
+      if (w.size() != 5 || lower(std::string(w[1])) != "normal") source.fail("expected 'facet normal nx ny nz'");
       for (std::size_t i = 2; i < 5; ++i) source.real(w[i], "normal component");
       state = State::facet;
     } else if (keyword == "outer") {
       expect(State::facet, "outside a facet");
-      if (w.size() != 2 || w[1] != "loop") source.fail("expected 'outer loop'");
+      if (w.size() != 2 || lower(std::string(w[1])) != "loop") source.fail("expected 'outer loop'");
       state = State::loop;
       corners = 0;
     } else if (keyword == "vertex") {
@@ -303,7 +309,7 @@ ImportedMesh read_ascii_stl(const std::filesystem::path& file, std::string text,
       expect(State::solid, "inside a facet or outside a solid");
       state = State::outside;
     } else {
-      source.fail("unknown keyword " + quoted(keyword));
+      source.fail("unknown keyword " + quoted(w[0]));
     }
   }
   if (state != State::outside) source.fail("the file ends inside a solid (no 'endsolid')");
@@ -477,7 +483,7 @@ bool starts_with(const std::string& text, std::string_view prefix) { return text
 // Binary STL may start with "solid" too (its 80-byte header is free text): it is binary when its size
 // is exactly what its facet count says, as assimp decides.
 bool is_ascii_stl(const std::string& text) {
-  if (!starts_with(text, "solid")) return false;
+  if (!starts_with(text, "solid")) return false;  // as assimp and check_binary_stl decide: lower case
   if (text.size() < 84) return true;
   std::uint32_t facets = 0;
   std::memcpy(&facets, text.data() + 80, 4);

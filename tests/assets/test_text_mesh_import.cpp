@@ -15,7 +15,9 @@
 #include <assimp/postprocess.h>
 #include <assimp/scene.h>
 
+#include <algorithm>
 #include <array>
+#include <cctype>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -317,6 +319,16 @@ TEST(TextMeshImport, PartsScalePolygonsAndDroppedElements) {
   ASSERT_EQ(stl.parts.size(), 2u);
   EXPECT_EQ(stl.parts[1].name, "b");
   EXPECT_DOUBLE_EQ(assets::signed_volume(stl.parts[1].mesh), 2.0);
+
+  // Capitals after the first "solid" (which must be lower case to tell ASCII from binary STL, as in
+  // assimp), as some older exporters write them; a '+' sign.
+  std::string upper = write_stl(box_mesh(Vec3(0, 0, 0), Vec3(1, 2, 3)), "C");
+  for (char& ch : upper) ch = static_cast<char>(std::toupper(static_cast<unsigned char>(ch)));
+  upper.replace(0, 5, "solid");
+  const std::string capitals = dir.write("capitals_ascii.stl", upper);
+  EXPECT_DOUBLE_EQ(assets::load_mesh_body(capitals).unit.volume, 6.0);
+  const std::string plus = dir.write("plus.obj", "v +0 0 0\nv +1 0 0\nv 0 +1.0 0\nv 0 0 +1e0\nf 1 3 2\nf 1 2 4\nf 1 4 3\nf 2 3 4\n");
+  EXPECT_DOUBLE_EQ(assets::load_mesh_body(plus).unit.volume, 1.0 / 6);
 }
 
 // Each defect: the file, the format, the line and what is wrong, in the calling process's error.
@@ -339,6 +351,7 @@ TEST(TextMeshImport, MalformedFilesNameTheLineAndTheDefect) {
       {"zero.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 0 1 2\n"},
       {"short.obj", "v 0 0\n"},
       {"number.obj", "v 0 0 0x1\n"},
+      {"sign.obj", "v +1 +.5 +-1\n"},
       {"unknown.obj", "v 0 0 0\nvertex 1 2 3\n"},
       {"surface.obj", "cstype bspline\n"},
       // ASCII STL
@@ -371,6 +384,7 @@ TEST(TextMeshImport, MalformedFilesNameTheLineAndTheDefect) {
       {"zero.obj", "malformed OBJ: line 4: vertex index 0 does not name one of the 3 vertices defined before it"},
       {"short.obj", "malformed OBJ: line 1: a vertex needs three coordinates"},
       {"number.obj", "malformed OBJ: line 1: coordinate '0x1' is not a number"},
+      {"sign.obj", "malformed OBJ: line 1: coordinate '+-1' is not a number"},
       {"unknown.obj", "malformed OBJ: line 2: unknown statement 'vertex'"},
       {"surface.obj",
        "malformed OBJ: line 1: free-form geometry ('cstype') is not supported: export the mesh as polygons"},
