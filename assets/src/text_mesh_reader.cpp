@@ -25,6 +25,7 @@
 #include <array>
 #include <charconv>
 #include <cstdint>
+#include <cstdio>
 #include <cstring>
 #include <fstream>
 #include <limits>
@@ -45,9 +46,22 @@ bool plus_sign(std::string_view token) {
   return token.size() > 1 && token[0] == '+' && token[1] != '+' && token[1] != '-';
 }
 
+// A word of the file for a message: at most 40 bytes, control and non-ASCII bytes as \xHH, so a hostile
+// file cannot put a NUL, an escape sequence or a line break into the error.
 std::string quoted(std::string_view token) {
   constexpr std::size_t kShown = 40;
-  return "'" + std::string(token.substr(0, kShown)) + (token.size() > kShown ? "…'" : "'");
+  std::string out = "'";
+  for (const char ch : token.substr(0, kShown)) {
+    const auto c = static_cast<unsigned char>(ch);
+    if (c >= 0x20 && c < 0x7f) {
+      out += ch;
+    } else {
+      char hex[8];
+      std::snprintf(hex, sizeof hex, "\\x%02X", c);
+      out += hex;
+    }
+  }
+  return out + (token.size() > kShown ? "…'" : "'");
 }
 
 // The file's text, line by line, with its line numbers, and the errors that name them.

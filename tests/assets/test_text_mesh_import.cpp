@@ -352,6 +352,7 @@ TEST(TextMeshImport, MalformedFilesNameTheLineAndTheDefect) {
       {"short.obj", "v 0 0\n"},
       {"number.obj", "v 0 0 0x1\n"},
       {"sign.obj", "v +1 +.5 +-1\n"},
+      {"bytes.obj", std::string("v 0 0 0\n\x1b[2J\xff\0 1 2\n", 19)},
       {"unknown.obj", "v 0 0 0\nvertex 1 2 3\n"},
       {"surface.obj", "cstype bspline\n"},
       // ASCII STL
@@ -385,6 +386,7 @@ TEST(TextMeshImport, MalformedFilesNameTheLineAndTheDefect) {
       {"short.obj", "malformed OBJ: line 1: a vertex needs three coordinates"},
       {"number.obj", "malformed OBJ: line 1: coordinate '0x1' is not a number"},
       {"sign.obj", "malformed OBJ: line 1: coordinate '+-1' is not a number"},
+      {"bytes.obj", "malformed OBJ: line 2: unknown statement '\\x1B[2J\\xFF\\x00'"},
       {"unknown.obj", "malformed OBJ: line 2: unknown statement 'vertex'"},
       {"surface.obj",
        "malformed OBJ: line 1: free-form geometry ('cstype') is not supported: export the mesh as polygons"},
