@@ -142,10 +142,50 @@ std::vector<std::string_view> words(std::string_view line, char comment) {
   return out;
 }
 
-// A polygon's vertices, triangulated as a fan: exact for the mass properties of any planar polygon (the
-// fan's signed areas sum to the polygon's), and the usual convex faces of an export.
-void add_polygon(const std::vector<std::uint32_t>& polygon, std::vector<std::array<std::uint32_t, 3>>& triangles) {
-  for (std::size_t i = 1; i + 1 < polygon.size(); ++i) triangles.push_back({polygon[0], polygon[i], polygon[i + 1]});
+constexpr std::size_t kMaxEarClipping = 1024;  // vertices of one non-convex face: O(n³) below this
+
+// A polygon's vertices as triangles, counter-clockwise about the polygon's own (Newell) normal. A
+// convex polygon (every corner turns the same way) becomes a fan; a non-convex one is ear-clipped, as
+// assimp does: a fan would be exact for the mass properties (its signed areas sum to the polygon's)
+// but would put triangles outside the face, where a detector colliding the triangles would see them.
+void add_polygon(const Source& source, const std::vector<Vec3>& vertices, const std::vector<std::uint32_t>& polygon,
+                 std::vector<std::array<std::uint32_t, 3>>& triangles) {
+  const std::size_t n = polygon.size();
+  const auto at = [&](std::size_t i) -> const Vec3& { return vertices[polygon[i]]; };
+  Vec3 normal = Vec3::Zero();
+  for (std::size_t i = 0; i < n; ++i) normal += at(i).cross(at((i + 1) % n));
+  const auto turn = [&](const Vec3& a, const Vec3& b, const Vec3& c) { return (b - a).cross(c - b).dot(normal); };
+  bool convex = true;
+  for (std::size_t i = 0; i < n && convex; ++i) convex = !(turn(at(i), at((i + 1) % n), at((i + 2) % n)) < 0.0);
+  if (n == 3 || convex || !normal.allFinite() || normal.isZero()) {  // degenerate ones: validation says so
+    for (std::size_t i = 1; i + 1 < n; ++i) triangles.push_back({polygon[0], polygon[i], polygon[i + 1]});
+    return;
+  }
+  if (n > kMaxEarClipping)
+    source.fail("a non-convex face of " + std::to_string(n) + " vertices (more than " +
+                std::to_string(kMaxEarClipping) + "): triangulate it when exporting");
+  std::vector<std::uint32_t> left = polygon;
+  while (left.size() > 3) {
+    const std::size_t m = left.size();
+    bool clipped = false;
+    for (std::size_t i = 0; i < m && !clipped; ++i) {
+      const Vec3 &a = vertices[left[(i + m - 1) % m]], &b = vertices[left[i]], &c = vertices[left[(i + 1) % m]];
+      if (!(turn(a, b, c) > 0.0)) continue;  // a reflex (or straight) corner is no ear
+      bool empty = true;
+      for (std::size_t j = 0; j < m && empty; ++j) {
+        if (j == i || j == (i + m - 1) % m || j == (i + 1) % m) continue;
+        const Vec3& p = vertices[left[j]];
+        empty = !((b - a).cross(p - a).dot(normal) >= 0.0 && (c - b).cross(p - b).dot(normal) >= 0.0 &&
+                  (a - c).cross(p - c).dot(normal) >= 0.0);
+      }
+      if (!empty) continue;
+      triangles.push_back({left[(i + m - 1) % m], left[i], left[(i + 1) % m]});
+      left.erase(left.begin() + static_cast<std::ptrdiff_t>(i));
+      clipped = true;
+    }
+    if (!clipped) break;  // a self-intersecting polygon has no ear left: the rest as a fan
+  }
+  for (std::size_t i = 1; i + 1 < left.size(); ++i) triangles.push_back({left[0], left[i], left[i + 1]});
 }
 
 // A part's triangles as indices into the file's vertices, before the part gets its own vertices.
@@ -244,7 +284,7 @@ ImportedMesh read_obj(const std::filesystem::path& file, std::string text, const
                       " vertices defined before it");
         polygon.push_back(static_cast<std::uint32_t>(index));
       }
-      add_polygon(polygon, current().triangles);
+      add_polygon(source, vertices, polygon, current().triangles);
     } else if (keyword == "l") {
       if (w.size() < 3) source.fail("a line needs at least two vertices");
       dropped += w.size() - 2;
@@ -429,7 +469,7 @@ ImportedMesh read_ascii_ply(const std::filesystem::path& file, std::string text,
       }
       if (at != w.size()) source.fail("element '" + element.name + "' #" + std::to_string(n) + " has too many values");
       if (is_vertex) add_vertex(source, vertices, p);
-      if (is_face && polygon.size() >= 3) add_polygon(polygon, parts[0].triangles);
+      if (is_face && polygon.size() >= 3) add_polygon(source, vertices, polygon, parts[0].triangles);
       if (is_face && polygon.size() < 3) ++dropped;
     }
   }
@@ -483,7 +523,7 @@ ImportedMesh read_off(const std::filesystem::path& file, std::string text, const
       polygon.push_back(static_cast<std::uint32_t>(index));
     }
     for (std::size_t i = 1 + length; i < w.size(); ++i) source.real(w[i], "colour value");
-    if (polygon.size() >= 3) add_polygon(polygon, parts[0].triangles);
+    if (polygon.size() >= 3) add_polygon(source, vertices, polygon, parts[0].triangles);
     else ++dropped;
   }
   while (source.next_line(line))

@@ -313,6 +313,22 @@ TEST(TextMeshImport, PartsScalePolygonsAndDroppedElements) {
   const assets::MeshBody cube = assets::load_mesh_body(quads);
   EXPECT_DOUBLE_EQ(cube.unit.volume, 1.0);
 
+  // An L-shaped prism whose caps are non-convex hexagons: ear-clipped, so the triangles cover the caps
+  // exactly (a fan from the first corner would also cover the notch, counted twice over).
+  const std::string l_prism =
+      dir.write("l_prism.obj", "v 0 0 0\nv 2 0 0\nv 2 1 0\nv 1 1 0\nv 1 2 0\nv 0 2 0\n"
+                               "v 0 0 1\nv 2 0 1\nv 2 1 1\nv 1 1 1\nv 1 2 1\nv 0 2 1\n"
+                               "f 6 5 4 3 2 1\nf 7 8 9 10 11 12\n"
+                               "f 1 2 8 7\nf 2 3 9 8\nf 3 4 10 9\nf 4 5 11 10\nf 5 6 12 11\nf 6 1 7 12\n");
+  const assets::MeshBody l_body = assets::load_mesh_body(l_prism);
+  EXPECT_DOUBLE_EQ(l_body.unit.volume, 3.0);
+  double area = 0.0;
+  for (const auto& t : l_body.mesh->triangles)
+    area += (l_body.mesh->vertices[t[1]] - l_body.mesh->vertices[t[0]])
+                .cross(l_body.mesh->vertices[t[2]] - l_body.mesh->vertices[t[0]])
+                .norm() / 2;
+  EXPECT_DOUBLE_EQ(area, 2 * 3.0 + 8 * 1.0);
+
   const std::string solids = dir.write("solids_ascii.stl", write_stl(box_mesh(Vec3(0, 0, 0), Vec3(1, 1, 1)), "a") +
                                                                write_stl(box_mesh(Vec3(2, 0, 0), Vec3(3, 2, 1)), "b"));
   const assets::ImportedMesh stl = import_mesh(solids, {1.0, assets::PartMode::separate, assets::UnitMode::convert});

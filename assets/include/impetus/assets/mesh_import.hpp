@@ -11,8 +11,8 @@
 /// `<unit meter=…>`, FBX `UnitScaleFactor`) is converted, with a warning; a file that carries no unit
 /// (OBJ, STL, PLY, OFF) is read as metres, and a warning suggests a scale when the mesh is more than
 /// 10 m across (a part in millimetres or centimetres). glTF is metres by its specification.
-/// Triangles are counter-clockwise seen from outside; polygons are triangulated (fans in the text
-/// readers), points and lines
+/// Triangles are counter-clockwise seen from outside; polygons are triangulated (convex ones as fans,
+/// others by ear clipping), points and lines
 /// dropped (with a warning), and vertices at identical positions welded (assimp's
 /// aiProcess_JoinIdenticalVertices is not used: it keeps STL's per-facet vertices apart because their
 /// normals differ, and it merges within a tolerance rather than on equality).
