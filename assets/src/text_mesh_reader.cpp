@@ -38,6 +38,10 @@ namespace impetus::assets::detail {
 namespace {
 
 constexpr std::uint64_t kMaxVertices = std::numeric_limits<std::uint32_t>::max();
+constexpr std::size_t kMaxEarClipping = 1024;  // vertices of one non-convex face
+// Point-in-triangle tests for all the non-convex faces of one file (about a second): ear clipping is
+// O(n³) in the worst case, so a file of many large non-convex faces is bounded by work, not by count.
+constexpr std::uint64_t kEarClippingWork = 200'000'000;
 
 bool is_space(char c) { return c == ' ' || c == '\t' || c == '\r' || c == '\v' || c == '\f'; }
 
@@ -81,6 +85,14 @@ class Source {
   }
 
   std::size_t line_number() const { return line_; }
+
+  // Spends `steps` of the file's ear-clipping budget.
+  void spend(std::uint64_t steps) {
+    if (steps > clipping_work_left_)
+      fail("its non-convex faces take more than " + std::to_string(kEarClippingWork) +
+           " steps to triangulate: triangulate them when exporting");
+    clipping_work_left_ -= steps;
+  }
   std::size_t size() const { return text_.size(); }
   const std::string& label() const { return label_; }
 
@@ -126,6 +138,7 @@ class Source {
   std::string format_;
   std::size_t at_ = 0;
   std::size_t line_ = 0;
+  std::uint64_t clipping_work_left_ = kEarClippingWork;
 };
 
 // The whitespace-separated words of a line, up to a comment character (none: '\0').
@@ -142,13 +155,12 @@ std::vector<std::string_view> words(std::string_view line, char comment) {
   return out;
 }
 
-constexpr std::size_t kMaxEarClipping = 1024;  // vertices of one non-convex face: O(n³) below this
 
 // A polygon's vertices as triangles, counter-clockwise about the polygon's own (Newell) normal. A
 // convex polygon (every corner turns the same way) becomes a fan; a non-convex one is ear-clipped, as
 // assimp does: a fan would be exact for the mass properties (its signed areas sum to the polygon's)
 // but would put triangles outside the face, where a detector colliding the triangles would see them.
-void add_polygon(const Source& source, const std::vector<Vec3>& vertices, const std::vector<std::uint32_t>& polygon,
+void add_polygon(Source& source, const std::vector<Vec3>& vertices, const std::vector<std::uint32_t>& polygon,
                  std::vector<std::array<std::uint32_t, 3>>& triangles) {
   const std::size_t n = polygon.size();
   const auto at = [&](std::size_t i) -> const Vec3& { return vertices[polygon[i]]; };
@@ -167,11 +179,13 @@ void add_polygon(const Source& source, const std::vector<Vec3>& vertices, const 
   std::vector<std::uint32_t> left = polygon;
   while (left.size() > 3) {
     const std::size_t m = left.size();
+    std::uint64_t steps = 0;
     bool clipped = false;
     for (std::size_t i = 0; i < m && !clipped; ++i) {
       const Vec3 &a = vertices[left[(i + m - 1) % m]], &b = vertices[left[i]], &c = vertices[left[(i + 1) % m]];
       if (!(turn(a, b, c) > 0.0)) continue;  // a reflex (or straight) corner is no ear
       bool empty = true;
+      steps += m;
       for (std::size_t j = 0; j < m && empty; ++j) {
         if (j == i || j == (i + m - 1) % m || j == (i + 1) % m) continue;
         const Vec3& p = vertices[left[j]];
@@ -183,6 +197,7 @@ void add_polygon(const Source& source, const std::vector<Vec3>& vertices, const 
       left.erase(left.begin() + static_cast<std::ptrdiff_t>(i));
       clipped = true;
     }
+    source.spend(steps);
     if (!clipped) break;  // a self-intersecting polygon has no ear left: the rest as a fan
   }
   for (std::size_t i = 1; i + 1 < left.size(); ++i) triangles.push_back({left[0], left[i], left[i + 1]});

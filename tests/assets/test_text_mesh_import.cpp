@@ -419,6 +419,34 @@ TEST(TextMeshImport, MalformedFilesNameTheLineAndTheDefect) {
   }
 }
 
+// Ear clipping is bounded: a non-convex face of more than 1,024 corners, or non-convex faces that take
+// more than 2e8 point-in-triangle tests in all (here 400 star-shaped 1,024-gons), are refused.
+TEST(TextMeshImport, NonConvexFacesAreBoundedByWork) {
+  const TempDir dir;
+  const auto star = [](int n, int faces) {
+    std::string s;
+    for (int i = 0; i < n; ++i) {
+      const double r = i % 2 ? 0.5 : 1.0, a = 2 * std::numbers::pi * i / n;
+      s += "v " + g17(r * std::cos(a)) + " " + g17(r * std::sin(a)) + " 0\n";
+    }
+    std::string face = "f";
+    for (int i = 1; i <= n; ++i) face += " " + std::to_string(i);
+    for (int k = 0; k < faces; ++k) s += face + "\n";
+    return s;
+  };
+  const std::string big = dir.write("big.obj", star(1025, 1));
+  EXPECT_EQ(error_of([&] { import_mesh(big); }),
+            big + ": malformed OBJ: line 1026: a non-convex face of 1025 vertices (more than 1024): triangulate it when "
+                  "exporting");
+  const std::string many = dir.write("many.obj", star(1024, 400));
+  const std::string message = error_of([&] { import_mesh(many); });
+  EXPECT_EQ(message.rfind(many + ": malformed OBJ: line ", 0), 0u) << message;
+  EXPECT_NE(message.find(": its non-convex faces take more than 200000000 steps to triangulate: triangulate them "
+                         "when exporting"),
+            std::string::npos)
+      << message;
+}
+
 // A NaN coordinate in an OBJ or ASCII STL is read as NaN, as before: validation refuses it naming the
 // vertex. (In OFF and ASCII PLY the checks in the calling process refuse any letter first.)
 TEST(TextMeshImport, NonFiniteCoordinatesReachValidation) {
