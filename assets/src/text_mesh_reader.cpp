@@ -155,7 +155,6 @@ std::vector<std::string_view> words(std::string_view line, char comment) {
   return out;
 }
 
-
 // A polygon's vertices as triangles, counter-clockwise about the polygon's own (Newell) normal. A
 // convex polygon (every corner turns the same way) becomes a fan; a non-convex one is ear-clipped, as
 // assimp does: a fan would be exact for the mass properties (its signed areas sum to the polygon's)
@@ -169,7 +168,7 @@ void add_polygon(Source& source, const std::vector<Vec3>& vertices, const std::v
   const auto turn = [&](const Vec3& a, const Vec3& b, const Vec3& c) { return (b - a).cross(c - b).dot(normal); };
   bool convex = true;
   for (std::size_t i = 0; i < n && convex; ++i) convex = !(turn(at(i), at((i + 1) % n), at((i + 2) % n)) < 0.0);
-  if (n == 3 || convex || !normal.allFinite() || normal.isZero()) {  // degenerate ones: validation says so
+  if (n == 3 || convex || !normal.allFinite() || normal.squaredNorm() == 0.0) {  // degenerate ones: validation says so
     for (std::size_t i = 1; i + 1 < n; ++i) triangles.push_back({polygon[0], polygon[i], polygon[i + 1]});
     return;
   }
@@ -248,6 +247,13 @@ ImportedMesh assemble(const std::filesystem::path& file, std::string format, con
   return out;
 }
 
+// Three coordinates from w[first…], parsed left to right (so the first bad one is the one named).
+Vec3 point(const Source& source, const std::vector<std::string_view>& w, std::size_t first) {
+  Vec3 p;
+  for (std::size_t k = 0; k < 3; ++k) p[static_cast<Eigen::Index>(k)] = source.real(w[first + k], "coordinate");
+  return p;
+}
+
 void add_vertex(const Source& source, std::vector<Vec3>& vertices, const Vec3& p) {
   if (vertices.size() >= kMaxVertices) source.fail("more than " + std::to_string(kMaxVertices) + " vertices");
   vertices.push_back(p);
@@ -283,7 +289,7 @@ ImportedMesh read_obj(const std::filesystem::path& file, std::string text, const
     if (keyword == "v") {
       if (w.size() < 4) source.fail("a vertex needs three coordinates");
       if (w.size() > 8) source.fail("a vertex has at most x y z and w or r g b");
-      const Vec3 p(source.real(w[1], "coordinate"), source.real(w[2], "coordinate"), source.real(w[3], "coordinate"));
+      const Vec3 p = point(source, w, 1);
       for (std::size_t i = 4; i < w.size(); ++i) source.real(w[i], "value");
       add_vertex(source, vertices, p);
     } else if (keyword == "f") {
@@ -363,8 +369,7 @@ ImportedMesh read_ascii_stl(const std::filesystem::path& file, std::string text,
       expect(State::loop, "outside a loop");
       if (w.size() != 4) source.fail("expected 'vertex x y z'");
       if (corners == 3) source.fail("a facet has more than three vertices");
-      add_vertex(source, vertices,
-                 Vec3(source.real(w[1], "coordinate"), source.real(w[2], "coordinate"), source.real(w[3], "coordinate")));
+      add_vertex(source, vertices, point(source, w, 1));
       triangle[corners++] = static_cast<std::uint32_t>(vertices.size() - 1);
     } else if (keyword == "endloop") {
       expect(State::loop, "outside a loop");
@@ -442,7 +447,8 @@ ImportedMesh read_ascii_ply(const std::filesystem::path& file, std::string text,
     for (std::size_t i = 0; i < element.properties.size(); ++i) {
       const Property& p = element.properties[i];
       for (int k = 0; k < 3; ++k)
-        if (is_vertex && !p.list && p.name == std::string(1, static_cast<char>('x' + k))) xyz[static_cast<std::size_t>(k)] = static_cast<int>(i);
+        if (is_vertex && !p.list && p.name == std::string(1, static_cast<char>('x' + k)))
+          xyz[static_cast<std::size_t>(k)] = static_cast<int>(i);
       if (is_face && p.list && (p.name == "vertex_indices" || p.name == "vertex_index")) indices = static_cast<int>(i);
     }
     if (is_vertex && (xyz[0] < 0 || xyz[1] < 0 || xyz[2] < 0)) source.fail("element 'vertex' has no x, y and z");
@@ -519,8 +525,7 @@ ImportedMesh read_off(const std::filesystem::path& file, std::string text, const
     next("vertex " + std::to_string(n) + " of " + std::to_string(vertex_count));
     if (w.size() < 3) source.fail("a vertex needs three coordinates");
     for (std::size_t i = 3; i < w.size(); ++i) source.real(w[i], "value");
-    add_vertex(source, vertices,
-               Vec3(source.real(w[0], "coordinate"), source.real(w[1], "coordinate"), source.real(w[2], "coordinate")));
+    add_vertex(source, vertices, point(source, w, 0));
   }
   std::vector<RawPart> parts(1, RawPart{"", {}});
   std::size_t dropped = 0;
@@ -546,8 +551,10 @@ ImportedMesh read_off(const std::filesystem::path& file, std::string text, const
   return assemble(file, "OFF (double precision)", vertices, std::move(parts), dropped, options);
 }
 
-// The first `n` bytes of the text, for recognising a format.
-bool starts_with(const std::string& text, std::string_view prefix) { return text.compare(0, prefix.size(), prefix) == 0; }
+// Whether the text starts with `prefix`, for recognising a format.
+bool starts_with(const std::string& text, std::string_view prefix) {
+  return text.compare(0, prefix.size(), prefix) == 0;
+}
 
 // Binary STL may start with "solid" too (its 80-byte header is free text): it is binary when its size
 // is exactly what its facet count says, as assimp decides.
