@@ -7,9 +7,9 @@ Good meshes are closed, outward-wound (counter-clockwise seen from outside), in 
 in several formats so tests can check that every importer gives the same body: Wavefront OBJ, STL
 (ASCII and binary), PLY (ASCII and binary), OFF, glTF 2.0 (.gltf with an embedded buffer, and .glb);
 the writers are in mesh_formats.py.
-Broken meshes (one defect each) exercise validation. Coordinates are rounded to float32 first (every
-format above stores float32 or is parsed into float32 by assimp) and printed in the shortest text that
-reads back as the same float32, so all formats hold bit-identical vertices.
+Broken meshes (one defect each) exercise validation. Coordinates are rounded to float32 first (the
+binary formats store float32) and printed in the shortest text that reads back, at double precision,
+as that same float32 value, so all formats hold bit-identical vertices.
 
 The output is deterministic: running the script twice gives byte-identical files (a test checks it).
 Python standard library only.

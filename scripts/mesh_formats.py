@@ -20,14 +20,16 @@ def f32(x):
 
 
 def num(x):
-    """Shortest decimal text that reads back as the float32 x (x is already float32-exact)."""
+    """Shortest decimal text that reads back as the float32 x at double precision too (x is already
+    float32-exact): the engine reads the text formats in double, so "0.1" would be 0.1, not the float32
+    0.100000001490116; the exact value keeps every format's vertices bit-identical."""
     if x != x:
         return "nan"
     if x == 0.0:
         return "0"  # also for -0.0: the sign of zero means nothing here
-    for digits in range(1, 10):
+    for digits in range(1, 18):
         text = "%.*g" % (digits, x)
-        if f32(float(text)) == x:
+        if float(text) == x:
             return text
     raise AssertionError(x)
 

@@ -155,6 +155,32 @@ std::string assimp_version() {
   return "assimp " + std::to_string(aiGetVersionMajor()) + "." + std::to_string(aiGetVersionMinor());
 }
 
+void finish_import(ImportedMesh& out, std::size_t dropped, const ImportOptions& options) {
+  const std::string label = out.file.string();
+  if (out.parts.empty())
+    throw Error(label + ": the file holds no triangles" +
+                (dropped ? " (only " + std::to_string(dropped) + " points or lines)" : std::string()));
+  if (dropped)
+    out.warnings.push_back(label + ": dropped " + std::to_string(dropped) +
+                           " points and lines (a solid is made of triangles only)");
+  for (ImportedPart& part : out.parts) weld_identical_vertices(part.mesh);
+
+  // A unitless file read as metres that comes out huge was probably written in mm or cm.
+  if (!out.file_unit && options.scale == 1.0 && lower(out.format).find("gltf") == std::string::npos) {
+    double extent = 0.0;
+    for (const ImportedPart& part : out.parts) {
+      Vec3 lo = Vec3::Constant(INFINITY), hi = -lo;
+      for (const Vec3& v : part.mesh.vertices)
+        if (v.allFinite()) lo = lo.cwiseMin(v), hi = hi.cwiseMax(v);
+      if ((hi.array() >= lo.array()).all()) extent = std::max(extent, (hi - lo).maxCoeff());
+    }
+    if (extent > kLargeMesh)
+      out.warnings.push_back(label + ": the mesh is " + number(extent) +
+                             " m across; this format carries no unit, so its numbers were read as metres (if they "
+                             "are millimetres, give scale 0.001; centimetres, 0.01)");
+  }
+}
+
 ImportedMesh read_with_assimp(const std::filesystem::path& file, const ImportOptions& options) {
   const std::string label = file.string();
   Assimp::Importer importer;
@@ -207,28 +233,7 @@ ImportedMesh read_with_assimp(const std::filesystem::path& file, const ImportOpt
       if (!part.mesh.triangles.empty()) out.parts.push_back(std::move(part));
     }
   }
-  if (out.parts.empty())
-    throw Error(label + ": the file holds no triangles" +
-                (dropped ? " (only " + std::to_string(dropped) + " points or lines)" : std::string()));
-  if (dropped)
-    out.warnings.push_back(label + ": dropped " + std::to_string(dropped) +
-                           " points and lines (a solid is made of triangles only)");
-  for (ImportedPart& part : out.parts) weld_identical_vertices(part.mesh);
-
-  // A unitless file read as metres that comes out huge was probably written in mm or cm.
-  if (!out.file_unit && options.scale == 1.0 && lower(out.format).find("gltf") == std::string::npos) {
-    double extent = 0.0;
-    for (const ImportedPart& part : out.parts) {
-      Vec3 lo = Vec3::Constant(INFINITY), hi = -lo;
-      for (const Vec3& v : part.mesh.vertices)
-        if (v.allFinite()) lo = lo.cwiseMin(v), hi = hi.cwiseMax(v);
-      if ((hi.array() >= lo.array()).all()) extent = std::max(extent, (hi - lo).maxCoeff());
-    }
-    if (extent > kLargeMesh)
-      out.warnings.push_back(label + ": the mesh is " + number(extent) +
-                             " m across; this format carries no unit, so its numbers were read as metres (if they "
-                             "are millimetres, give scale 0.001; centimetres, 0.01)");
-  }
+  finish_import(out, dropped, options);
   return out;
 }
 

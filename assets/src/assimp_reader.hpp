@@ -4,6 +4,7 @@
 
 #include "impetus/assets/mesh_import.hpp"
 
+#include <cstddef>
 #include <filesystem>
 #include <string>
 
@@ -15,6 +16,11 @@ namespace impetus::assets::detail {
 /// Error("<file>: …") for a file assimp cannot read or that holds no triangles. May crash, abort or
 /// exhaust memory inside assimp on a malformed file: that is why it runs in its own process by default.
 ImportedMesh read_with_assimp(const std::filesystem::path& file, const ImportOptions& options);
+
+/// The common end of every reader: refuses a file whose parts hold no triangles (naming the `dropped`
+/// points and lines), warns about dropped ones, welds each part, and warns when a unitless mesh read at
+/// scale 1 is more than 10 m across. `out.file` and `out.format` must be set.
+void finish_import(ImportedMesh& out, std::size_t dropped, const ImportOptions& options);
 
 /// The assimp in use, as "assimp 5.2" (named in the importer's failure messages).
 std::string assimp_version();

@@ -8,9 +8,9 @@
 // memory limit; 4 when its limits could not be set; a signal when assimp crashed or the CPU time limit
 // ran out.
 
-#include "assimp_reader.hpp"
 #include "import_protocol.hpp"
 #include "importer_process.hpp"
+#include "text_mesh_reader.hpp"
 
 #include "impetus/core/error.hpp"
 
@@ -30,7 +30,7 @@ int main(int argc, char** argv) {
   if (reply < 0) return detail::kExitSetupFailed;
   std::string bytes;
   try {
-    impetus::assets::ImportedMesh mesh = detail::read_with_assimp(request.file, request.options);
+    impetus::assets::ImportedMesh mesh = detail::read_mesh_file(request.file, request.options);
     bytes = detail::encode_mesh_reply(mesh);
   } catch (const impetus::Error& e) {
     bytes = detail::encode_error_reply(e.what());

@@ -1,20 +1,23 @@
 #pragma once
 /// \file
-/// Mesh import through assimp 5.2: Wavefront OBJ, STL (ASCII and binary), PLY, OFF, glTF 2.0
-/// (.gltf/.glb), COLLADA and the other formats assimp reads. The result is the engine's own
-/// TriangleMesh: no assimp type crosses this header.
+/// Mesh import: Wavefront OBJ, ASCII STL, ASCII PLY and OFF by the engine's own readers at double
+/// precision; binary STL, binary PLY, glTF 2.0 (.gltf/.glb), COLLADA and the other formats assimp reads
+/// through assimp 5.2, whose vertices are float32 (binary STL and glTF store float32 by definition;
+/// assets/README.md, "Precision"). The result is the engine's own TriangleMesh: no assimp type crosses
+/// this header.
 ///
 /// Conventions. Coordinates are taken in the file's own axes (no up-axis conversion: rotate a body
 /// with the scene's `orientation`). Lengths come out in metres: a file that states its unit (COLLADA
 /// `<unit meter=…>`, FBX `UnitScaleFactor`) is converted, with a warning; a file that carries no unit
 /// (OBJ, STL, PLY, OFF) is read as metres, and a warning suggests a scale when the mesh is more than
 /// 10 m across (a part in millimetres or centimetres). glTF is metres by its specification.
-/// Triangles are counter-clockwise seen from outside; polygons are triangulated, points and lines
+/// Triangles are counter-clockwise seen from outside; polygons are triangulated (convex ones as fans,
+/// others by ear clipping), points and lines
 /// dropped (with a warning), and vertices at identical positions welded (assimp's
 /// aiProcess_JoinIdenticalVertices is not used: it keeps STL's per-facet vertices apart because their
 /// normals differ, and it merges within a tolerance rather than on equality).
 ///
-/// Isolation. assimp reads the file in a separate process, `impetus-mesh-import`, found next to
+/// Isolation. assimp (or the text reader) reads the file in a separate process, `impetus-mesh-import`, found next to
 /// libimpetus_assets.so (`<libdir>/impetus/libexec/`, in the build tree and in an installed, relocated
 /// prefix alike). assimp 5.2 can crash, abort or allocate without bound on a malformed file; in that
 /// process this ends the import with an Error naming the file and what happened, never the program.
@@ -71,14 +74,15 @@ struct ImportedPart {
 /// The result of importing one file.
 struct ImportedMesh {
   std::filesystem::path file;
-  std::string format;                ///< assimp's importer, e.g. "Wavefront Object Importer"
+  std::string format;                ///< e.g. "Wavefront OBJ (double precision)", or assimp's importer name
   std::optional<double> file_unit;   ///< metres per file unit, when the file states one
   std::vector<ImportedPart> parts;   ///< one (merge) or one per node with meshes (separate)
   std::vector<std::string> warnings; ///< complete sentences, each naming the file
 };
 
 /// Imports `file`. Throws Error("<file>: <problem>") when it cannot be opened, is empty, is a
-/// truncated binary STL, cannot be parsed, or holds no triangles; and, with isolation, when the
+/// truncated binary STL, cannot be parsed (a text format: "<file>: malformed OBJ: line N: …"), or holds
+/// no triangles; and, with isolation, when the
 /// importer process crashed (the signal is named), ran out of its memory, CPU time or wall-clock limit,
 /// sent a malformed reply, or cannot be found or started. The mesh is not validated here (see
 /// mesh_validation.hpp). May be called from several threads at once.
