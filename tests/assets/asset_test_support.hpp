@@ -1,13 +1,15 @@
 #pragma once
-// Helpers for the asset tests: bundled mesh paths, meshes built in memory (double precision), and an
-// independent reference for mass properties (signed-tetrahedron decomposition).
+// Helpers for the asset tests: bundled mesh paths, meshes built in memory (double precision), an
+// independent reference for mass properties (signed-tetrahedron decomposition), and error capture.
 
 #include "impetus/assets/mass_properties.hpp"
+#include "impetus/core/error.hpp"
 #include "impetus/core/shape.hpp"
 
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <functional>
 #include <numbers>
 #include <string>
 
@@ -88,6 +90,16 @@ inline double relative_error(double a, double b) { return std::abs(a - b) / std:
 /// A rotation about a skewed axis (no symmetry of any test body lines up with it).
 inline Mat3 skew_rotation() {
   return Eigen::AngleAxisd(0.7, Vec3(1.0, 2.0, 3.0).normalized()).toRotationMatrix();
+}
+
+/// The message of the Error `f` throws, or "(no error)".
+inline std::string error_of(const std::function<void()>& f) {
+  try {
+    f();
+  } catch (const Error& e) {
+    return e.what();
+  }
+  return "(no error)";
 }
 
 }  // namespace impetus::test

@@ -29,15 +29,6 @@ const std::map<std::string, std::pair<std::size_t, std::size_t>> kMeshes = {
     {"cube", {8, 12}}, {"box", {8, 12}}, {"tetrahedron", {4, 4}}, {"l_bracket", {12, 20}},
     {"t_handle", {16, 28}}, {"icosphere_2", {162, 320}}};
 
-std::string error_of(const std::function<void()>& f) {
-  try {
-    f();
-  } catch (const Error& e) {
-    return e.what();
-  }
-  return "(no error)";
-}
-
 // Every format holds the same float32 vertices, so every import gives the same welded mesh and
 // bit-identical mass properties (compared to 1e-15 to leave room for summation order).
 TEST(MeshImport, EveryFormatGivesTheSameBody) {

@@ -53,15 +53,6 @@ class ScopedEnv {
   std::vector<std::pair<const char*, std::optional<std::string>>> saved_;
 };
 
-std::string error_of(const std::function<void()>& f) {
-  try {
-    f();
-  } catch (const Error& e) {
-    return e.what();
-  }
-  return "(no error)";
-}
-
 // The message of importing the tetrahedron through the fake importer in `mode`, with `extra` settings.
 std::string fake_import_error(const std::string& mode,
                               std::initializer_list<std::pair<const char*, std::string>> extra = {}) {

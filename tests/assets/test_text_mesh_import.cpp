@@ -280,15 +280,6 @@ TEST(TextMeshImport, EveryTextFormatGivesTheSameVerticesInAndOutOfProcess) {
   }
 }
 
-std::string error_of(const std::function<void()>& f) {
-  try {
-    f();
-  } catch (const Error& e) {
-    return e.what();
-  }
-  return "(no error)";
-}
-
 // Parts: OBJ objects and groups, STL solids; scale; polygons; points and lines dropped with a warning.
 TEST(TextMeshImport, PartsScalePolygonsAndDroppedElements) {
   const TempDir dir;
