@@ -60,6 +60,14 @@ struct PluginRequest {
 
 class LoadedLibrary;
 
+/// Typed settings of a plugin (impetus/settings/): the options they stand for, and the plugin they
+/// configure by default.
+template <class Settings>
+concept PluginSettings = requires(const Settings& s) {
+  { s.to_options() } -> std::same_as<ModuleOptions>;
+  { Settings::plugin_name } -> std::convertible_to<std::string>;
+};
+
 /// Finds and loads plugins. Not thread-safe; one per process is typical but not required.
 class PluginHost {
  public:
@@ -94,38 +102,29 @@ class PluginHost {
   /// `host.create_resolver(settings)` loads the plugin the type names with the options the settings
   /// stand for; `host.create_resolver("name", settings)` loads another plugin that reads the same
   /// options. The options go through the same checks as a scene's; messages start with "code".
-  template <class Settings>
-    requires requires(const Settings& s) { { s.to_options() } -> std::same_as<ModuleOptions>; }
+  template <PluginSettings Settings>
   std::shared_ptr<Integrator> create_integrator(const Settings& settings, const std::string& name = Settings::plugin_name) {
     ModuleOptions options = settings.to_options();
     return create_integrator(typed_request(ModuleKind::integrator, name, options));
   }
-  template <class Settings>
-    requires requires(const Settings& s) { { s.to_options() } -> std::same_as<ModuleOptions>; }
+  template <PluginSettings Settings>
   std::shared_ptr<CollisionDetector> create_detector(const Settings& settings, const std::string& name = Settings::plugin_name) {
     ModuleOptions options = settings.to_options();
     return create_detector(typed_request(ModuleKind::detector, name, options));
   }
-  template <class Settings>
-    requires requires(const Settings& s) { { s.to_options() } -> std::same_as<ModuleOptions>; }
+  template <PluginSettings Settings>
   std::shared_ptr<CollisionResolver> create_resolver(const Settings& settings, const std::string& name = Settings::plugin_name) {
     ModuleOptions options = settings.to_options();
     return create_resolver(typed_request(ModuleKind::resolver, name, options));
   }
-  template <class Settings>
-    requires requires(const Settings& s) { { s.to_options() } -> std::same_as<ModuleOptions>; }
-  std::shared_ptr<CollisionResolver> create_resolver(const std::string& name, const Settings& settings) {
-    return create_resolver(settings, name);
+  std::shared_ptr<Integrator> create_integrator(const std::string& name, const PluginSettings auto& settings) {
+    return create_integrator(settings, name);
   }
-  template <class Settings>
-    requires requires(const Settings& s) { { s.to_options() } -> std::same_as<ModuleOptions>; }
-  std::shared_ptr<CollisionDetector> create_detector(const std::string& name, const Settings& settings) {
+  std::shared_ptr<CollisionDetector> create_detector(const std::string& name, const PluginSettings auto& settings) {
     return create_detector(settings, name);
   }
-  template <class Settings>
-    requires requires(const Settings& s) { { s.to_options() } -> std::same_as<ModuleOptions>; }
-  std::shared_ptr<Integrator> create_integrator(const std::string& name, const Settings& settings) {
-    return create_integrator(settings, name);
+  std::shared_ptr<CollisionResolver> create_resolver(const std::string& name, const PluginSettings auto& settings) {
+    return create_resolver(settings, name);
   }
 
   /// Loads every `impetus_*.so` in the search path and reports what each is, or why it failed. A file
