@@ -11,12 +11,14 @@
 
 #include <Eigen/Eigenvalues>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <string>
+#include <vector>
 
 #ifndef IMPETUS_FUZZ_SCENE_DIR
 #error "IMPETUS_FUZZ_SCENE_DIR must be defined by the build (the bundled scene directory)"
@@ -53,6 +55,17 @@ class ScratchDir {
   fs::path path_;
 };
 
+// What the loader accepts, the World must accept: the same checks live in both places.
+void require_world_accepts(const Scene& scene) {
+  try {
+    World world(scene.settings);
+    for (const RigidBody& body : scene.bodies) world.add_body(body);
+    for (const Constraint& constraint : scene.constraints) world.add_constraint(constraint);
+  } catch (const Error& e) {
+    invariant_broken(std::string("the scene loaded but the World refused it: ") + e.what());
+  }
+}
+
 }  // namespace
 
 Outcome scene_one_input(const std::uint8_t* data, std::size_t size) {
@@ -63,14 +76,38 @@ Outcome scene_one_input(const std::uint8_t* data, std::size_t size) {
   } catch (const Error&) {
     return Outcome::rejected;
   }
-  // What the loader accepts, the World must accept: the same checks live in both places.
+  require_world_accepts(scene);
+  return Outcome::accepted;
+}
+
+Outcome overrides_one_input(const std::uint8_t* data, std::size_t size) {
+  static const std::string base =
+      "dt: 0.001\n"
+      "modules: {integrator: momentum, detector: {plugin: fcl, margin: 1.0e-4}, resolver: ledas}\n"
+      "bodies:\n"
+      "  - {name: ground, fixed: true, shape: {plane: {normal: [0, 0, 1], offset: -5}}}\n"
+      "  - {name: ball, shape: {sphere: {radius: 0.5}}, mass: 1, position: [0, 0, 3]}\n"
+      "  - {name: box, shape: {box: {size: [1, 1, 1]}}, mass: 2, position: [3, 0, 3]}\n"
+      "generators:\n"
+      "  - line: {count: 3, radius: 0.1, velocity: [1, 0, 0]}\n"
+      "  - pyramid: {rows: 2, radius: 0.1, ground: false}\n"
+      "constraints:\n"
+      "  - point_point: {bodies: [ball, box], point: [1.5, 0, 3]}\n";
+  const std::string text(reinterpret_cast<const char*>(data), size);
+  Scene scene;
   try {
-    World world(scene.settings);
-    for (const RigidBody& body : scene.bodies) world.add_body(body);
-    for (const Constraint& constraint : scene.constraints) world.add_constraint(constraint);
-  } catch (const Error& e) {
-    invariant_broken(std::string("the scene loaded but the World refused it: ") + e.what());
+    std::vector<SceneOverride> overrides;
+    std::size_t start = 0;
+    while (start <= text.size()) {
+      const std::size_t end = std::min(text.find('\n', start), text.size());
+      if (end > start) overrides.push_back(parse_override(text.substr(start, end - start)));
+      start = end + 1;
+    }
+    scene = load_scene_text(base, "fuzz.yaml", IMPETUS_FUZZ_SCENE_DIR, overrides);
+  } catch (const Error&) {
+    return Outcome::rejected;
   }
+  require_world_accepts(scene);
   return Outcome::accepted;
 }
 

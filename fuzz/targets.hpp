@@ -21,6 +21,12 @@ enum class Outcome { accepted, rejected };
 /// constraint by constraint, which must accept it too.
 Outcome scene_one_input(const std::uint8_t* data, std::size_t size);
 
+/// `--set` overrides and generator parameters: `data` is lines of KEY=VALUE, each parsed as the command
+/// line parses one `--set` and applied to a small scene with two bodies, a constraint, and a line and a
+/// pyramid generator (so `generators.0.line.count=…` and `bodies.ball.velocity=…` reach every
+/// generator parameter and body field); an accepted scene must then be accepted by a World, as above.
+Outcome overrides_one_input(const std::uint8_t* data, std::size_t size);
+
 /// The mesh pipeline: `data` is written to a private temporary file named `input.<extension>`
 /// (extension without the dot: obj, stl, ply, off, gltf, glb, dae) and imported, validated, given mass
 /// properties and a convex hull (assets::load_mesh_body). An accepted mesh must have a positive finite

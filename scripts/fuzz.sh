@@ -22,7 +22,7 @@ while [ $# -gt 0 ]; do
     *) targets+=("$1"); shift ;;
   esac
 done
-[ ${#targets[@]} -gt 0 ] || targets=(scene mesh_obj mesh_stl mesh_ply mesh_off mesh_gltf mesh_glb mesh_dae)
+[ ${#targets[@]} -gt 0 ] || targets=(scene set mesh_obj mesh_stl mesh_ply mesh_off mesh_gltf mesh_glb mesh_dae)
 
 werror=OFF
 [ "${CI:-}" = "true" ] && werror=ON

@@ -32,6 +32,6 @@ fi
 
 if [ "${IMPETUS_FUZZ_SECONDS:-60}" != "0" ]; then
   # Every target, the mesh formats included: assimp runs in its own process (assets/README.md), so an
-  # input that crashes assimp is a clear error, not a crash of the fuzzer. 8 targets, $(nproc) at a time.
+  # input that crashes assimp is a clear error, not a crash of the fuzzer. 9 targets, $(nproc) at a time.
   "$root/scripts/fuzz.sh" --time "${IMPETUS_FUZZ_SECONDS:-60}"
 fi

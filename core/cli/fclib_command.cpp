@@ -1,7 +1,9 @@
 // `impetus fclib solve` and `impetus fclib export` (fclib_command.hpp).
 #include "fclib_command.hpp"
+#include "report.hpp"
 
 #include "impetus/core/error.hpp"
+#include "impetus/core/format.hpp"
 #include "impetus/fclib/fclib.hpp"
 #include "impetus/plugins/host.hpp"
 
@@ -87,22 +89,19 @@ int run_fclib_solve(const FclibSolveArgs& args) {
 
 int run_fclib_export(const Scene& scene, World& world, const FclibExportArgs& args) {
   const fs::path out(args.out);
+  check_output_path(out, args.overwrite, scene.file, "--out");
   if (!world.constraints().empty())
     throw Error(scene.file.string() + ": has " + std::to_string(world.constraints().size()) +
                 " constraints; fclib export writes contact problems only (assembly constraints are not exported)");
   if (!world.has_detector()) throw Error(scene.file.string() + ": export needs a detector (modules.detector is 'none')");
   std::error_code ec;
-  if (fs::exists(out, ec)) {
-    if (!args.overwrite) throw Error(args.out + ": exists already (use --overwrite to replace it)");
-    if (fs::is_directory(out, ec)) throw Error(args.out + ": is a directory");
-  }
   const StepStatus& status = world.detect_contacts();
   if (!status.ok) throw Error(scene.file.string() + ": " + status.message);
   fclib::SceneProblem problem = fclib::scene_problem(world.bodies(), world.contacts(), world.settings().dt);
   if (problem.contacts.empty()) throw Error(scene.file.string() + ": no contact between a movable body and another body after one detection");
   const fclib::Info info{"Impetus: " + scene.file.filename().string(),
                          "the contact problem of " + scene.file.filename().string() +
-                             " after one detection at its initial state, dt " + std::to_string(world.settings().dt) +
+                             " after one detection at its initial state, dt " + format_number(world.settings().dt) +
                              " s; the inelastic impact (restitution not included)",
                          ""};
   problem.global.info = problem.local.info = info;

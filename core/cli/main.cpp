@@ -6,6 +6,7 @@
 #include "report.hpp"
 
 #include "impetus/core/error.hpp"
+#include "impetus/core/format.hpp"
 #include "impetus/engine/scene.hpp"
 #include "impetus/plugins/host.hpp"
 
@@ -28,6 +29,9 @@ using namespace impetus;
 namespace {
 
 using Clock = std::chrono::steady_clock;
+
+// Step counts and the time t = n dt stay exact integers in a double up to 2^53.
+constexpr double kMaxSteps = 9007199254740992.0;
 
 // How to read the run summary (README.md, "The run summary", says the same at length).
 constexpr const char* kRunSummaryHelp = R"help(The summary:
@@ -67,7 +71,7 @@ fs::path demo_scene() {
 // Command-line module and dt flags are overrides like any --set, applied before validation.
 Scene load(const SceneArgs& args) {
   std::vector<SceneOverride> overrides;
-  if (args.dt) overrides.push_back({"dt", std::to_string(*args.dt)});
+  if (args.dt) overrides.push_back({"dt", format_number(*args.dt)});
   if (!args.integrator.empty()) overrides.push_back({"modules.integrator", args.integrator});
   if (!args.detector.empty()) overrides.push_back({"modules.detector", args.detector});
   if (!args.resolver.empty()) overrides.push_back({"modules.resolver", args.resolver});
@@ -131,12 +135,20 @@ int run_command(const SceneArgs& args, std::optional<std::uint64_t> steps, std::
   if (duration) {
     if (!(*duration >= 0.0) || !std::isfinite(*duration))
       throw Error("--duration: must be a non-negative number of seconds");
-    total = static_cast<std::uint64_t>(std::llround(*duration / dt));
+    const double count = std::round(*duration / dt);
+    if (!(count <= kMaxSteps))
+      throw Error("--duration " + format_number(*duration) + ": at dt " + format_number(dt) + " s that is " +
+                  format_number(count) + " steps, more than the " + format_number(kMaxSteps) +
+                  " a run can count exactly (2^53)");
+    total = static_cast<std::uint64_t>(count);
   }
+  if (steps && static_cast<double>(*steps) > kMaxSteps)
+    throw Error("--steps " + std::to_string(*steps) + ": more than the " + format_number(kMaxSteps) +
+                " a run can count exactly (2^53)");
 
   std::optional<cli::TrajectoryWriter> writer;
   if (!out_file.empty()) {
-    writer.emplace(out_file, overwrite);
+    writer.emplace(out_file, overwrite, scene.file);
     writer->write(*world);
   }
   cli::RunStats stats(*world);
@@ -150,10 +162,17 @@ int run_command(const SceneArgs& args, std::optional<std::uint64_t> steps, std::
       throw Error(scene.file.string() + ": " + status.message);
     }
     stats.add_step(*world, status);
+    if (const char* what = stats.non_finite()) {
+      progress.done();
+      throw Error(scene.file.string() + ": step " + std::to_string(world->step_count()) + " (t = " +
+                  format_number(world->time()) + " s): the run's " + what +
+                  " is no longer finite (velocities, masses or the time step too large to square)");
+    }
     if (writer && (world->step_count() % every == 0 || i + 1 == total)) writer->write(*world);
     progress.update(*world);
   }
   progress.done();
+  if (writer) writer->finish();
   const double wall = std::chrono::duration<double>(Clock::now() - start).count();
   nlohmann::json summary = stats.summary(*world, wall);
   summary["scene"] = scene.file.string();

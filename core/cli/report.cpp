@@ -1,6 +1,7 @@
 #include "report.hpp"
 
 #include "impetus/core/error.hpp"
+#include "impetus/core/format.hpp"
 
 #include <algorithm>
 #include <array>
@@ -17,11 +18,22 @@ using nlohmann::json;
 
 json vec(const Vec3& v) { return json::array({v.x(), v.y(), v.z()}); }
 
-// Shortest round-trip text of a double (std::to_chars), so CSV output is bit-exact.
-void append_number(std::string& line, double x) {
-  std::array<char, 32> buffer{};
-  const auto result = std::to_chars(buffer.data(), buffer.data() + buffer.size(), x);
-  line.append(buffer.data(), result.ptr);
+// Shortest round-trip text of a double, so CSV output is bit-exact.
+void append_number(std::string& line, double x) { line += format_number(x); }
+
+// A name as a CSV field (RFC 4180): quoted, with quotes doubled, when it holds a comma or a quote.
+// (Names with line breaks or other control characters are refused when a body is added.)
+void append_csv_text(std::string& line, const std::string& text) {
+  if (text.find_first_of(",\"") == std::string::npos) {
+    line += text;
+    return;
+  }
+  line += '"';
+  for (char c : text) {
+    if (c == '"') line += '"';
+    line += c;
+  }
+  line += '"';
 }
 
 }  // namespace
@@ -55,6 +67,8 @@ void RunStats::before_step(const World& world) {
 void RunStats::add_integration_step(const World& world, const StepStatus& status, double step_load_work) {
   const double kinetic = total_kinetic_energy(world.bodies());
   const double potential = load_potential_energy(world.bodies(), world.settings().gravity);
+  kinetic_after_ = kinetic;
+  potential_after_ = potential;
   const double remainder = (kinetic - step_kinetic_) + (potential - step_potential_) -
                            status.resolve_kinetic_energy_change - status.resolve_potential_energy_change -
                            step_load_work;
@@ -62,6 +76,19 @@ void RunStats::add_integration_step(const World& world, const StepStatus& status
   // did through them (a belt's push and the gravity kick its contact takes back happen in one step).
   const double taken_back = std::max(0.0, status.prescribed_work - status.resolve_kinetic_energy_change);
   contact_exchange_ += std::clamp(remainder, 0.0, taken_back);
+}
+
+const char* RunStats::non_finite() const {
+  if (!std::isfinite(kinetic_after_)) return "kinetic energy";
+  if (!std::isfinite(potential_after_)) return "potential energy of gravity and loads";
+  if (!std::isfinite(contact_energy_change_) || !std::isfinite(correction_energy_) ||
+      !std::isfinite(prescribed_work_) || !std::isfinite(contact_exchange_))
+    return "energy exchanged by contacts";
+  if (!std::isfinite(step_load_work_)) return "work of applied loads";
+  if (!all_finite(gravity_impulse_) || !all_finite(gravity_moment_) || !all_finite(load_impulse_) ||
+      !all_finite(load_moment_) || !all_finite(fixed_impulse_) || !all_finite(fixed_moment_))
+    return "momentum balance";
+  return nullptr;
 }
 
 // Contact convention (modules/contact.hpp): the impulse P = p n + p_t acts +P on b and −P on a. Only a
@@ -145,11 +172,11 @@ json RunStats::energy_summary(const World& world) const {
   const double rounding = std::max(1e-9, 1e-15 * static_cast<double>(steps_)) * scale;
   json unexpected = json::array();
   if (-dissipated > rounding)
-    unexpected.push_back("contacts gained " + std::to_string(-dissipated) + " J beyond the work of moving fixed bodies");
+    unexpected.push_back("contacts gained " + format_number(-dissipated) + " J beyond the work of moving fixed bodies");
   // Net: a bounded, oscillating integration error (splitting) is not a gain unless it ends as one.
   const double integration_gain = integration - contact_exchange_;
   if (integration_gain > rounding)
-    unexpected.push_back("integration gained " + std::to_string(integration_gain) +
+    unexpected.push_back("integration gained " + format_number(integration_gain) +
                          " J beyond what contacts took back in the same steps");
   const double e0 = total_energy(initial_), e1 = total_energy(now);
   return json{{"initial_j", e0},
@@ -322,13 +349,34 @@ void print_summary(const json& s, std::ostream& out) {
       << "max penetration       " << s["max_penetration_m"].get<double>() << " m\n";
 }
 
-TrajectoryWriter::TrajectoryWriter(const std::filesystem::path& file, bool overwrite) : file_(file) {
+void check_output_path(const std::filesystem::path& out, bool overwrite, const std::filesystem::path& input,
+                       const std::string& option) {
+  namespace fs = std::filesystem;
   std::error_code ec;
-  if (!overwrite && std::filesystem::exists(file, ec))
-    throw Error(file.string() + ": file exists; pass --overwrite to replace it");
+  const std::string name = option + " " + out.string();
+  if (fs::is_symlink(fs::symlink_status(out, ec)) && !fs::exists(out, ec))
+    throw Error(name + ": is a symbolic link to '" + fs::read_symlink(out, ec).string() +
+                "', which does not exist; Impetus does not create files through a dangling link");
+  if (!fs::exists(out, ec)) return;
+  if (fs::is_directory(out, ec)) throw Error(name + ": is a directory");
+  if (!input.empty() && fs::equivalent(out, input, ec))
+    throw Error(name + ": is the scene being read; an input is never overwritten by an output");
+  if (!overwrite) throw Error(name + ": file exists; pass --overwrite to replace it");
+}
+
+TrajectoryWriter::TrajectoryWriter(const std::filesystem::path& file, bool overwrite,
+                                   const std::filesystem::path& input)
+    : file_(file) {
+  check_output_path(file, overwrite, input, "--out");
   out_.open(file, std::ios::out | std::ios::trunc);
   if (!out_) throw Error(file.string() + ": cannot open for writing");
   out_ << "step,time,body,x,y,z,qw,qx,qy,qz,vx,vy,vz,wx,wy,wz\n";
+}
+
+void TrajectoryWriter::finish() {
+  out_.flush();
+  out_.close();
+  if (!out_) throw Error(file_.string() + ": writing failed (the device is full or the file cannot be written)");
 }
 
 void TrajectoryWriter::write(const World& world) {
@@ -339,7 +387,7 @@ void TrajectoryWriter::write(const World& world) {
     line += ',';
     append_number(line, world.time());
     line += ',';
-    line += b.name;
+    append_csv_text(line, b.name);
     const Quat q = b.orientation();
     const double values[] = {b.position.x(), b.position.y(), b.position.z(), q.w(), q.x(), q.y(), q.z(),
                              b.velocity.x(), b.velocity.y(), b.velocity.z(), b.angular_velocity.x(),
@@ -351,7 +399,7 @@ void TrajectoryWriter::write(const World& world) {
     line += '\n';
     out_ << line;
   }
-  if (!out_) throw Error(file_.string() + ": write failed");
+  if (!out_) throw Error(file_.string() + ": writing failed (the device is full or the file cannot be written)");
 }
 
 json resolve_report(const World& world, const std::string& resolver, double seconds) {

@@ -31,6 +31,10 @@ class RunStats {
   void before_step(const World& world);
   /// Adds the step just taken (after world.step()).
   void add_step(const World& world, const StepStatus& status);
+  /// What in the run's accounting is no longer finite ("kinetic energy", …), or null: a step whose
+  /// state stays finite can still overflow an energy or a momentum (1e200 m/s squared), and a summary
+  /// of inf and nan would be garbage.
+  const char* non_finite() const;
   /// The summary as JSON (units in key names: _s, _j, _m …).
   nlohmann::json summary(const World& world, double wall_seconds) const;
 
@@ -60,6 +64,7 @@ class RunStats {
   // resting (or landing) body gravity's kick before the contact removes it, an exchange, not a gain.
   double contact_exchange_ = 0.0;
   double step_kinetic_ = 0.0, step_potential_ = 0.0;  // KE and −Σ (m g + F)·x before the current step
+  double kinetic_after_ = 0.0, potential_after_ = 0.0;  // the same after the last step
   StepProfile time_;                     // summed over steps
   std::uint64_t steps_ = 0, contacts_ = 0, max_contacts_ = 0, rounds_ = 0, max_rounds_ = 0;
   std::uint64_t non_converged_ = 0, singular_ = 0, redundant_ = 0, pulling_ = 0, energy_gains_ = 0;
@@ -71,13 +76,21 @@ class RunStats {
 /// Prints a run summary for people.
 void print_summary(const nlohmann::json& summary, std::ostream& out);
 
+/// Refuses an output path that would lose data or hurt an input, naming `option` (e.g. "--out"): an
+/// existing file without `overwrite`, a directory, a symbolic link to nothing (it would create a file
+/// elsewhere), or the same file as `input` (the scene being read), even with `overwrite`.
+void check_output_path(const std::filesystem::path& out, bool overwrite, const std::filesystem::path& input,
+                       const std::string& option);
+
 /// Writes one CSV row per body per recorded step: step,time,body,x,y,z,qw,qx,qy,qz,vx,vy,vz,wx,wy,wz.
 /// Numbers use the shortest text that reads back to the same double, so the file is bit-exact.
 class TrajectoryWriter {
  public:
-  /// Opens `file` for writing; refuses to replace an existing file unless `overwrite`.
-  TrajectoryWriter(const std::filesystem::path& file, bool overwrite);
+  /// Opens `file` for writing after check_output_path (`input`: the scene being run).
+  TrajectoryWriter(const std::filesystem::path& file, bool overwrite, const std::filesystem::path& input);
   void write(const World& world);
+  /// Flushes and closes the file; throws Error if any write failed (a full disk, /dev/full).
+  void finish();
 
  private:
   std::filesystem::path file_;

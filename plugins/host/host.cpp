@@ -113,9 +113,8 @@ std::vector<fs::path> plugin_files(const fs::path& dir) {
   fs::directory_iterator it(dir, ec), end;
   for (; !ec && it != end; it.increment(ec)) {
     const std::string name = it->path().filename().string();
-    std::error_code type_ec;
-    if (name.starts_with(kFilePrefix) && name.ends_with(kFileSuffix) && fs::is_regular_file(it->path(), type_ec))
-      files.push_back(it->path());
+    // Not only regular files: load() reports a directory or FIFO named like a plugin as a failure.
+    if (name.starts_with(kFilePrefix) && name.ends_with(kFileSuffix)) files.push_back(it->path());
   }
   std::sort(files.begin(), files.end(), [](const fs::path& a, const fs::path& b) {
     const bool a_named = parse_file_name(a.filename().string()).has_value();
@@ -226,6 +225,12 @@ std::shared_ptr<LoadedLibrary> PluginHost::load(const fs::path& file, std::strin
     reason = "cannot open the file: " + ec.message();
     return nullptr;
   }
+  // dlopen blocks forever on a FIFO and reads a device without end: only a regular file is a library.
+  if (const fs::file_status status = fs::status(canonical, ec); !fs::is_regular_file(status)) {
+    reason = fs::is_directory(status) ? "is a directory, not a shared library"
+                                      : "is not a regular file (a device, FIFO or socket), not a shared library";
+    return nullptr;
+  }
   std::erase_if(open_, [](const auto& entry) { return entry.second.expired(); });
   if (auto it = open_.find(canonical); it != open_.end())
     if (auto library = it->second.lock()) return library;
@@ -292,7 +297,7 @@ fs::path PluginHost::find_by_name(ModuleKind kind, const std::string& name) cons
   const std::string file_name = file_name_for(kind, name);
   for (const fs::path& dir : search_path_) {
     std::error_code ec;
-    if (fs::is_regular_file(dir / file_name, ec)) return dir / file_name;
+    if (fs::exists(fs::symlink_status(dir / file_name, ec))) return dir / file_name;  // load() checks its type
   }
   return {};
 }

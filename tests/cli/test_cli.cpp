@@ -195,6 +195,66 @@ TEST(Cli, OutRefusesToOverwriteAnExistingFile) {
   EXPECT_EQ(run("run --steps 5 --overwrite --out " + f.string()).status, 0);
 }
 
+// Outputs that would lose data (README.md, "The `impetus` tool"): every write is checked to the end, an
+// input is never an output, a dangling link is not followed.
+TEST(Cli, OutputsThatWouldLoseDataAreRefused) {
+  const Result full = run("run --steps 5 --overwrite --out /dev/full");
+  EXPECT_NE(full.status, 0);
+  EXPECT_NE(full.out.find("/dev/full: writing failed"), std::string::npos) << full.out;
+
+  const fs::path copy = temp_file("input.yaml");
+  fs::copy_file(scene("spin.yaml"), copy, fs::copy_options::overwrite_existing);
+  const std::string before = read(copy);
+  const Result same = run("run " + copy.string() + " --steps 5 --overwrite --out " + copy.string());
+  EXPECT_NE(same.status, 0);
+  EXPECT_NE(same.out.find("is the scene being read"), std::string::npos) << same.out;
+  EXPECT_EQ(read(copy), before);
+  const Result same_fclib = run("fclib export " + copy.string() + " --overwrite --out " + copy.string());
+  EXPECT_NE(same_fclib.out.find("is the scene being read"), std::string::npos) << same_fclib.out;
+  EXPECT_EQ(read(copy), before);
+
+  const fs::path link = temp_file("dangling.csv"), target = temp_file("not_there") / "x.csv";
+  fs::remove(link);
+  fs::create_symlink(target, link);
+  const Result dangling = run("run --steps 5 --out " + link.string());
+  EXPECT_NE(dangling.status, 0);
+  EXPECT_NE(dangling.out.find("dangling"), std::string::npos) << dangling.out;
+  EXPECT_FALSE(fs::exists(target));
+}
+
+// A body name with a comma or a quote is one CSV field (RFC 4180 quoting); the row keeps 16 fields.
+TEST(Cli, NamesWithCommasAreQuotedInTheTrajectory) {
+  const fs::path f = temp_file("quoted.csv");
+  const Result r = run("run " + scene("spin.yaml") + " --steps 1 --overwrite --out " + f.string() +
+                       " --set 'bodies.0.name=\"a,b\\\"c\"'");
+  ASSERT_EQ(r.status, 0) << r.out;
+  const std::string csv = read(f);
+  EXPECT_NE(csv.find("\n0,0,\"a,b\"\"c\","), std::string::npos) << csv;
+}
+
+// Counts and numbers through flags: a duration or step count beyond 2^53 steps is refused, not run
+// "forever" after an overflow; --dt keeps every digit (it was formatted with six decimals).
+TEST(Cli, FlagsKeepTheirValueOrAreRefused) {
+  const Result huge = run("run --duration 1e30");
+  EXPECT_NE(huge.status, 0);
+  EXPECT_NE(huge.out.find("--duration 1e+30: at dt"), std::string::npos) << huge.out;
+  const Result steps = run("run --steps 18446744073709551615");
+  EXPECT_NE(steps.status, 0);
+  EXPECT_NE(steps.out.find("a run can count exactly (2^53)"), std::string::npos) << steps.out;
+  for (const char* dt : {"1e-07", "0.0001234567"}) {
+    const Result r = run(std::string("run --steps 3 --json --dt ") + dt);
+    ASSERT_EQ(r.status, 0) << r.out;
+    EXPECT_EQ(nlohmann::json::parse(r.out)["simulated_time_s"].get<double>(), 3 * std::stod(dt)) << dt;
+  }
+}
+
+// A step whose state stays finite but whose energy overflows fails the run (it printed inf and nan).
+TEST(Cli, RunsWhoseAccountingOverflowsFail) {
+  const Result r = run("run --steps 3 --dt 1e300");
+  EXPECT_NE(r.status, 0);
+  EXPECT_NE(r.out.find("non-finite"), std::string::npos) << r.out;
+}
+
 TEST(Cli, ResolveWithoutADetectorIsAClearError) {
   const Result r = run("resolve " + scene("spin.yaml"));
   EXPECT_NE(r.status, 0);
@@ -236,7 +296,7 @@ TEST(Cli, FclibRefusesWhatItCannotUse) {
   const std::string pyramid = std::string(IMPETUS_SOURCE_DIR) + "/assets/scenes/pyramid_drop_10.yaml";
   Result r = run("fclib export " + pyramid + " --out " + f.string());
   EXPECT_NE(r.status, 0);
-  EXPECT_NE(r.out.find("exists already"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("file exists; pass --overwrite"), std::string::npos) << r.out;
   EXPECT_EQ(read(f), "precious\n");
 
   r = run("fclib solve " + f.string());  // not HDF5

@@ -40,17 +40,18 @@ TEST_P(FuzzInputs, RunWithoutCrashing) {
     const std::string bytes = bytes_of(file);
     const auto* data = reinterpret_cast<const std::uint8_t*>(bytes.data());
     const fuzz::Outcome outcome = target == "scene" ? fuzz::scene_one_input(data, bytes.size())
+                                  : target == "set" ? fuzz::overrides_one_input(data, bytes.size())
                                                     : fuzz::mesh_one_input(data, bytes.size(), target.substr(5));
     ++(outcome == fuzz::Outcome::accepted ? accepted : rejected);
   }
   EXPECT_GT(accepted, 0) << target << ": the corpus must hold inputs the pipeline accepts";
-  if (target == "scene" || target == "mesh_obj" || target == "mesh_stl") {
+  if (target == "scene" || target == "set" || target == "mesh_obj" || target == "mesh_stl") {
     EXPECT_GT(rejected, 0) << target << ": the corpus must hold inputs the pipeline rejects";
   }
 }
 
 INSTANTIATE_TEST_SUITE_P(Targets, FuzzInputs,
-                         testing::Values("scene", "mesh_obj", "mesh_stl", "mesh_ply", "mesh_off", "mesh_gltf",
+                         testing::Values("scene", "set", "mesh_obj", "mesh_stl", "mesh_ply", "mesh_off", "mesh_gltf",
                                          "mesh_glb", "mesh_dae"));
 
 }  // namespace

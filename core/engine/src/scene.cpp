@@ -3,8 +3,10 @@
 
 #include "impetus/engine/scene.hpp"
 
+#include "impetus/core/format.hpp"
 #include "impetus/plugins/host.hpp"
 #include "scene_internal.hpp"
+#include "scene_yaml.hpp"
 
 #include <cerrno>
 #include <cstring>
@@ -36,7 +38,8 @@ void add_bodies(const SceneReader& r, std::vector<ReadBody> read, bool generated
     if (!inserted && generated && same_fixed_plane(scene.bodies[it->second], b.body)) continue;
     if (!inserted)
       r.fail(b.where, "duplicate body name '" + b.body.name + "' (first at " + where_by_name[b.body.name] + ")");
-    where_by_name[b.body.name] = r.where(b.where);
+    const std::string& where = where_by_name[b.body.name] = r.where(b.where);
+    scene.body_where.push_back(where);
     scene.bodies.push_back(std::move(b.body));
   }
 }
@@ -94,10 +97,26 @@ Scene read_scene(const SceneReader& r, const YAML::Node& root) {
       add_bodies(r, scene_detail::read_generator(r, entry), true, scene, index_by_name, where_by_name);
   // Constraints last: they name bodies, including generated ones, and use their initial poses.
   if (const YAML::Node* n = f.find("constraints"))
-    for (const YAML::Node& entry : r.list(*n, "constraints"))
+    for (const YAML::Node& entry : r.list(*n, "constraints")) {
       scene.constraints.push_back(scene_detail::read_constraint(r, entry, scene.bodies, index_by_name));
+      scene.constraint_where.push_back(r.where(entry));
+    }
   return scene;
 }
+
+// What a path that is not a regular file is, for messages.
+std::string file_kind(const std::filesystem::file_status& status) {
+  switch (status.type()) {
+    case std::filesystem::file_type::character: return "a character device";
+    case std::filesystem::file_type::block: return "a block device";
+    case std::filesystem::file_type::fifo: return "a FIFO";
+    case std::filesystem::file_type::socket: return "a socket";
+    default: return "not a file";
+  }
+}
+
+// Prefix of errors about a scene once loaded: its file, or "scene" for one built in code.
+std::string scene_label(const Scene& scene) { return scene.file.empty() ? "scene" : scene.file.string(); }
 
 // A programmatic Scene may leave a module empty: it gets the scene file's default.
 PluginRequest plugin_request(const ModuleRequest& module, ModuleKind kind, const char* fallback,
@@ -117,7 +136,7 @@ Scene load_scene_text(const std::string& yaml, const std::string& name, const st
                       const std::vector<SceneOverride>& overrides) {
   SceneReader reader(name, base_dir);
   try {
-    YAML::Node root = YAML::Load(yaml);
+    YAML::Node root = scene_detail::load_bounded_yaml(yaml, name);
     scene_detail::apply_overrides(root, overrides, reader);
     Scene scene = read_scene(reader, root);
     scene.warnings = reader.warnings();
@@ -129,10 +148,13 @@ Scene load_scene_text(const std::string& yaml, const std::string& name, const st
 }
 
 Scene load_scene(const std::filesystem::path& file, const std::vector<SceneOverride>& overrides) {
-  // A directory opens as a stream on Linux and reads as nothing; say what it is instead.
+  // A directory opens as a stream on Linux and reads as nothing, a device (/dev/zero) reads without end
+  // and a FIFO blocks until someone writes: only a regular file (or a link to one) is read.
   std::error_code ec;
-  if (std::filesystem::is_directory(file, ec))
-    throw Error(file.string() + ": is a directory, not a scene file");
+  const std::filesystem::file_status status = std::filesystem::status(file, ec);
+  if (std::filesystem::is_directory(status)) throw Error(file.string() + ": is a directory, not a scene file");
+  if (std::filesystem::exists(status) && !std::filesystem::is_regular_file(status))
+    throw Error(file.string() + ": is not a regular file (" + file_kind(status) + "); a scene is read from a file");
   // Refuse enormous files before reading them into memory (a scene is a few kilobytes; generators make
   // big scenes from a few lines).
   constexpr std::uintmax_t kMaxSceneBytes = std::uintmax_t{64} << 20;
@@ -150,15 +172,37 @@ Scene load_scene(const std::filesystem::path& file, const std::vector<SceneOverr
   return scene;
 }
 
+namespace {
+
+// The first body with friction a resolver that does not model it refuses, and the first constraint
+// `resolver` refuses, each located where the scene wrote it (the world would say only "body 'x'" or
+// "constraint #i").
+void check_constraints(const Scene& scene, CollisionResolver& resolver, const std::string& name) {
+  if (const ModuleStatus friction = resolver.accept_friction(); !friction)
+    for (std::size_t i = 0; i < scene.bodies.size() && i < scene.body_where.size(); ++i)
+      if (scene.bodies[i].material.friction > 0.0)
+        throw Error(scene.body_where[i] + ": body '" + scene.bodies[i].name + "' has friction " +
+                    format_number(scene.bodies[i].material.friction) + ", but resolver '" + name + "': " +
+                    friction.message + "; set its friction to 0 or choose a resolver (or mode) that models "
+                    "friction, such as ledas or mirtich");
+  const ModuleStatus all = resolver.accept_constraints(scene.constraints);
+  if (all) return;
+  for (std::size_t i = 0; i < scene.constraints.size() && i < scene.constraint_where.size(); ++i)
+    if (!resolver.accept_constraints(std::span(scene.constraints).subspan(i, 1)))
+      throw Error(scene.constraint_where[i] + ": resolver '" + name + "' refuses this constraint: " + all.message);
+  throw Error(scene_label(scene) + ": resolver '" + name + "': " + all.message);
+}
+
+}  // namespace
+
 std::unique_ptr<World> build_world(const Scene& scene, PluginHost& host) {
   host.prepend_directories(scene.plugin_path);
   auto world = std::make_unique<World>(scene.settings);
-  std::vector<BodyIndex> index;  // scene index → world index
-  index.reserve(scene.bodies.size());
-  for (const RigidBody& body : scene.bodies) index.push_back(world->add_body(body));
-  for (Constraint constraint : scene.constraints) {
-    std::visit([&](auto& c) { c.a = index.at(c.a), c.b = index.at(c.b); }, constraint);
-    world->add_constraint(constraint);
+  try {
+    world->add_bodies(scene.bodies);  // a fresh world: scene index = world index
+    for (const Constraint& constraint : scene.constraints) world->add_constraint(constraint);
+  } catch (const Error& e) {
+    throw Error(scene_label(scene) + ": " + e.what());
   }
   // The host reads (and marks as read) the options, so each module gets its own copy.
   ModuleOptions integrator_options = scene.integrator.options;
@@ -170,8 +214,14 @@ std::unique_ptr<World> build_world(const Scene& scene, PluginHost& host) {
   }
   if (scene.resolver.plugin != "none") {
     ModuleOptions options = scene.resolver.options;
-    world->set_resolver(
-        host.create_resolver(plugin_request(scene.resolver, ModuleKind::resolver, "ledas", options)));
+    const PluginRequest request = plugin_request(scene.resolver, ModuleKind::resolver, "ledas", options);
+    std::shared_ptr<CollisionResolver> resolver = host.create_resolver(request);
+    check_constraints(scene, *resolver, request.name);
+    try {
+      world->set_resolver(std::move(resolver));
+    } catch (const Error& e) {
+      throw Error(scene_label(scene) + ": " + e.what());  // a body's friction the resolver does not model
+    }
   }
   return world;
 }

@@ -2,6 +2,7 @@
 // loads (movable bodies) and prescribed motion (fixed bodies).
 
 #include "impetus/assets/mesh_body.hpp"
+#include "impetus/core/format.hpp"
 #include "impetus/core/mass.hpp"
 #include "scene_body_setup.hpp"
 #include "scene_internal.hpp"
@@ -45,11 +46,8 @@ Shape read_shape(const SceneReader& r, const YAML::Node& node) {
   }
   if (kind.key == "plane") {
     const Fields f(r, kind.value, "plane", {"normal", "offset"});
-    const YAML::Node& normal_node = f.require("normal");
-    const Vec3 normal = r.vec3(normal_node, "normal");
-    if (normal.norm() == 0.0) r.fail(normal_node, "'normal' must not be the zero vector");
     const YAML::Node* offset = f.find("offset");
-    return Plane{normal.normalized(), offset ? r.number(*offset, "offset") : 0.0};
+    return Plane{r.direction(f.require("normal"), "normal"), offset ? r.number(*offset, "offset") : 0.0};
   }
   // A mesh: imported (once per file, scale and part in this scene), validated, moved so the body
   // frame's origin is its center of mass (the body's `position` places that point), with its convex
@@ -110,8 +108,8 @@ Mat3 read_inertia(const SceneReader& r, const YAML::Node& node) {
   const Vec3 principal = Eigen::SelfAdjointEigenSolver<Mat3>(inertia, Eigen::EigenvaluesOnly).eigenvalues();
   if (!(principal.minCoeff() > 0.0))
     r.fail(node, "'inertia' must be positive definite; its principal moments are " +
-                     std::to_string(principal[0]) + ", " + std::to_string(principal[1]) + ", " +
-                     std::to_string(principal[2]));
+                     format_number(principal[0]) + ", " + format_number(principal[1]) + ", " +
+                     format_number(principal[2]));
   // A real mass distribution has I1 + I2 ≥ I3 for its principal moments (ascending here).
   if (principal[0] + principal[1] < principal[2] * (1.0 - 1e-9))
     r.fail(node, "'inertia' is not that of any rigid body: its principal moments break I1 + I2 >= I3");
@@ -151,6 +149,9 @@ ReadBody read_body(const SceneReader& r, const YAML::Node& node, std::size_t ind
   out.where = f.require("name");
   body.name = r.string(out.where, "name");
   if (body.name.empty()) r.fail(out.where, "'name' must not be empty");
+  if (has_control_character(body.name))
+    r.fail(out.where, "'name' holds a control character (a line break, tab or NUL); names go into CSV files "
+                      "and messages, so write them on one line");
   const bool fixed = f.find("fixed") ? r.boolean(*f.find("fixed"), "fixed") : false;
   const YAML::Node& shape_node = f.require("shape");
   body.shape = read_shape(r, shape_node);
@@ -216,6 +217,15 @@ ReadBody read_body(const SceneReader& r, const YAML::Node& node, std::size_t ind
   if (!std::isfinite(body.mass) || !(body.inv_mass > 0.0) || !std::isfinite(body.inv_mass) ||
       !body.inertia_body.allFinite() || !body.inv_inertia_body.allFinite())
     r.fail(mass ? *mass : *density, "the mass properties of " + f.context() + " are not finite numbers");
+  // Finite values whose products are not: the energies and momenta every step measures.
+  const Vec3 spin = body.rotation * body.inertia_body * body.rotation.transpose() * body.angular_velocity;
+  if (const YAML::Node* n = f.find("velocity"); n && !std::isfinite(body.mass * body.velocity.squaredNorm()))
+    r.fail(*n, "'velocity' with mass " + format_number(body.mass) + " overflows the kinetic energy (m |v|² must be finite)");
+  if (const YAML::Node* n = f.find("angular_velocity"); n && !std::isfinite(spin.dot(body.angular_velocity)))
+    r.fail(*n, "'angular_velocity' overflows the kinetic energy (ω·Iω must be finite)");
+  if (const YAML::Node* n = f.find("position"); n && !std::isfinite(body.mass * body.position.norm()))
+    r.fail(*n, "'position' with mass " + format_number(body.mass) + " overflows the moments measured about "
+               "the origin (m |x| must be finite)");
   return out;
 }
 

@@ -3,6 +3,7 @@
 #include "scene_body_setup.hpp"
 
 #include "impetus/core/error.hpp"
+#include "impetus/core/format.hpp"
 
 #include <cassert>
 #include <cmath>
@@ -37,7 +38,7 @@ namespace impetus {
 void set_primitive_mass(RigidBody& body, double mass) {
   const std::string label = "body '" + body.name + "'";
   if (!(mass > 0.0) || !std::isfinite(mass))
-    throw Error(label + ": mass must be positive and finite, got " + std::to_string(mass));
+    throw Error(label + ": mass must be positive and finite, got " + format_number(mass));
   const std::optional<UnitMassProperties> unit = primitive_mass_properties(body.shape);
   if (!unit)
     throw Error(label + ": a " + std::string(shape_kind_name(body.shape)) +

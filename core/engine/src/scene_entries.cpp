@@ -1,9 +1,11 @@
 // `generators:` and `constraints:` entries: the ones that make bodies in bulk or refer to them by name.
 
+#include "impetus/core/format.hpp"
 #include "impetus/engine/generators.hpp"
 #include "scene_internal.hpp"
 
 #include <climits>
+#include <cmath>
 
 namespace impetus::scene_detail {
 namespace {
@@ -132,9 +134,7 @@ Constraint read_constraint(const SceneReader& r, const YAML::Node& node, const s
   const Fields f(r, kind.value, "coaxial", {"bodies", "point", "axis", "length", "level", "collide"});
   const ConstraintEnds ends = read_ends(r, f, bodies, index_by_name);
   const Vec3 point = r.vec3(f.require("point"), "point");
-  const YAML::Node& axis_node = f.require("axis");
-  const Vec3 axis = r.vec3(axis_node, "axis");
-  if (!(axis.norm() > 1e-12)) r.fail(axis_node, "'axis' must be a non-zero vector");
+  const Vec3 unit = r.direction(f.require("axis"), "axis");
   CoaxialConstraint c;
   c.a = ends.a;
   c.b = ends.b;
@@ -142,9 +142,16 @@ Constraint read_constraint(const SceneReader& r, const YAML::Node& node, const s
   c.collide = ends.collide;
   if (const YAML::Node* n = f.find("length")) {
     c.length = r.number(*n, "length");
-    if (!(c.length > 0.0)) r.fail(*n, "'length' must be positive, got " + std::to_string(c.length));
+    if (!(c.length > 0.0)) r.fail(*n, "'length' must be positive, got " + format_number(c.length));
+    // The rows' lever arms grow with the length; the resolver's system holds their squares over the
+    // bodies' inertia, which must stay finite.
+    const auto flexibility = [](const RigidBody& b) {
+      return b.fixed ? 0.0 : b.inv_inertia_body.cwiseAbs().maxCoeff() + b.inv_mass;
+    };
+    if (!std::isfinite(c.length * c.length * (flexibility(bodies[c.a]) + flexibility(bodies[c.b]))))
+      r.fail(*n, "'length' " + format_number(c.length) + " overflows the constraint's rows (length² over the "
+                 "bodies' inertia must be finite)");
   }
-  const Vec3 unit = axis.normalized();
   c.anchor_a = to_body(bodies[c.a], point);
   c.anchor_b = to_body(bodies[c.b], point);
   c.axis_a = bodies[c.a].rotation.transpose() * unit;

@@ -2,11 +2,11 @@
 
 #include "impetus/engine/generators.hpp"
 
+#include "impetus/core/format.hpp"
 #include "impetus/core/mass.hpp"
 #include "scene_body_setup.hpp"
 
 #include <cmath>
-#include <sstream>
 #include <string>
 
 namespace impetus {
@@ -16,29 +16,29 @@ namespace {
 constexpr int kMaxRows = 1000;        // 500 500 spheres
 constexpr int kMaxCount = 1000000;
 
-std::string text(double x) {
-  std::ostringstream out;
-  out.precision(17);
-  out << x;
-  return out.str();
-}
-
 // Range checks shared by both generators; `kind` prefixes the message ("pyramid", "line").
 void check_common(const char* kind, double radius, double mass, const Vec3& velocity, double restitution,
                   double friction, double overlap) {
   const std::string k = kind;
   if (!(radius > 0.0) || !std::isfinite(radius))
-    throw GeneratorError("radius", k + " 'radius' must be a positive number, got " + text(radius));
+    throw GeneratorError("radius", k + " 'radius' must be a positive number, got " + format_number(radius));
   if (!(mass > 0.0) || !std::isfinite(mass))
-    throw GeneratorError("mass", k + " 'mass' must be a positive number, got " + text(mass));
+    throw GeneratorError("mass", k + " 'mass' must be a positive number, got " + format_number(mass));
+  // The inertia 2/5 m r² and the spacing of thousands of bodies must stay finite (a radius of 1e200
+  // passes the check above and overflows both).
+  if (!std::isfinite(0.4 * mass * radius * radius) || !std::isfinite(radius * 4.0e6))
+    throw GeneratorError("radius", k + " 'radius' " + format_number(radius) + " with 'mass' " + format_number(mass) +
+                                       " overflows the inertia or the positions (m r² and 2r × count must be finite)");
   if (!velocity.allFinite()) throw GeneratorError("velocity", k + " 'velocity' must be finite");
+  if (!std::isfinite(mass * velocity.squaredNorm()))
+    throw GeneratorError("velocity", k + " 'velocity' overflows the kinetic energy (m |v|² must be finite)");
   if (!(restitution >= 0.0 && restitution <= 1.0))
     throw GeneratorError("restitution",
-                         k + " 'restitution' must be between 0 and 1, got " + text(restitution));
+                         k + " 'restitution' must be between 0 and 1, got " + format_number(restitution));
   if (!(friction >= 0.0) || !std::isfinite(friction))
-    throw GeneratorError("friction", k + " 'friction' must be a finite number >= 0, got " + text(friction));
+    throw GeneratorError("friction", k + " 'friction' must be a finite number >= 0, got " + format_number(friction));
   if (!(overlap >= 0.0 && overlap < 1.0))
-    throw GeneratorError("overlap", k + " 'overlap' must be at least 0 and below 1, got " + text(overlap));
+    throw GeneratorError("overlap", k + " 'overlap' must be at least 0 and below 1, got " + format_number(overlap));
 }
 
 RigidBody sphere_body(std::string name, double radius, double mass, const Vec3& position, double restitution,

@@ -2,6 +2,7 @@
 // is checked exactly like a written one.
 
 #include "scene_internal.hpp"
+#include "scene_yaml.hpp"
 
 #include <algorithm>
 #include <cctype>
@@ -67,9 +68,10 @@ void apply_overrides(YAML::Node& root, const std::vector<SceneOverride>& overrid
     const std::vector<std::string> path = split_path(o.key, label);
     YAML::Node value;
     try {
-      value = YAML::Load(o.value);
+      value = load_bounded_yaml(o.value, label);
     } catch (const YAML::Exception& e) {
-      throw Error(label + ": the value '" + o.value + "' is not valid YAML: " + e.msg);
+      const std::string shown = o.value.size() > 80 ? o.value.substr(0, 77) + "..." : o.value;
+      throw Error(label + ": the value '" + shown + "' is not valid YAML: " + e.msg);
     }
     if (root.IsNull()) root = YAML::Node(YAML::NodeType::Map);
     // `cur` walks down the tree; reset() rebinds it (operator= would overwrite the node it names).

@@ -3,6 +3,7 @@
 #include "scene_reader.hpp"
 
 #include "impetus/assets/mesh_body.hpp"
+#include "impetus/core/format.hpp"
 
 #include <algorithm>
 #include <cctype>
@@ -22,14 +23,6 @@ std::string join(std::initializer_list<std::string_view> items) {
     out += item;
   }
   return out;
-}
-
-// Shortest text that reads back to the same double, for "got …" in messages.
-std::string format_number(double x) {
-  std::ostringstream out;
-  out.precision(17);
-  out << x;
-  return out.str();
 }
 
 // Levenshtein distance, for suggesting the key a typo meant.
@@ -211,6 +204,13 @@ std::vector<double> SceneReader::numbers(const YAML::Node& node, std::string_vie
 Vec3 SceneReader::vec3(const YAML::Node& node, std::string_view what) const {
   const std::vector<double> v = numbers(node, what, 3);
   return {v[0], v[1], v[2]};
+}
+
+Vec3 SceneReader::direction(const YAML::Node& node, std::string_view what) const {
+  const Vec3 v = vec3(node, what);
+  const double largest = v.cwiseAbs().maxCoeff();
+  if (largest == 0.0) fail(node, quote(what) + " must not be the zero vector");
+  return (v / largest).normalized();
 }
 
 std::vector<YAML::Node> SceneReader::list(const YAML::Node& node, std::string_view what) const {

@@ -64,6 +64,9 @@ class SceneReader {
   std::vector<double> numbers(const YAML::Node& node, std::string_view what, std::size_t n) const;
   /// [x, y, z] of finite numbers.
   Vec3 vec3(const YAML::Node& node, std::string_view what) const;
+  /// [x, y, z] of finite numbers, not all zero, as a unit vector: divided by its largest component
+  /// before it is normalized, so [0, 1e200, 1e200] and [1e-300, 0, 0] keep their direction.
+  Vec3 direction(const YAML::Node& node, std::string_view what) const;
   /// The elements of a list (a missing or null value is an empty list).
   std::vector<YAML::Node> list(const YAML::Node& node, std::string_view what) const;
 

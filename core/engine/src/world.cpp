@@ -1,12 +1,15 @@
 #include "impetus/engine/world.hpp"
 
 #include "impetus/core/error.hpp"
+#include "impetus/core/format.hpp"
 #include "impetus/engine/metrics.hpp"
 
 #include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <string>
+#include <string_view>
+#include <unordered_set>
 #include <utility>
 
 namespace impetus {
@@ -45,6 +48,9 @@ const char* motion_problem(const RigidBody& body) {
 // Physical validity of a body handed to the world. The scene loader checks the same values with file
 // positions; this catches bodies built in code.
 void validate_body(const RigidBody& body, std::size_t index) {
+  if (has_control_character(body.name))
+    throw Error("body #" + std::to_string(index) + ": its name holds a control character (a line break, tab or "
+                "NUL); names go into CSV files and messages");
   const std::string label = body_label(body, index);
   if (!state_is_finite(body) || !all_finite(body.force) || !all_finite(body.torque))
     throw Error(label + ": position, rotation, velocities and loads must be finite");
@@ -52,9 +58,9 @@ void validate_body(const RigidBody& body, std::size_t index) {
       !(body.rotation.determinant() > 0.0))
     throw Error(label + ": rotation is not a proper rotation matrix");
   if (!std::isfinite(body.material.friction) || body.material.friction < 0.0)
-    throw Error(label + ": friction must be finite and >= 0, got " + std::to_string(body.material.friction));
+    throw Error(label + ": friction must be finite and >= 0, got " + format_number(body.material.friction));
   if (!std::isfinite(body.material.restitution) || body.material.restitution < 0.0)
-    throw Error(label + ": restitution must be finite and >= 0, got " + std::to_string(body.material.restitution));
+    throw Error(label + ": restitution must be finite and >= 0, got " + format_number(body.material.restitution));
   if (std::holds_alternative<Plane>(body.shape) && !body.fixed)
     throw Error(label + ": a plane is an infinite half-space and must be fixed");
   if (!all_finite(body.force_body) || !all_finite(body.torque_body))
@@ -63,11 +69,18 @@ void validate_body(const RigidBody& body, std::size_t index) {
   if (body.fixed) return;
   if (!(body.mass > 0.0) || !std::isfinite(body.mass) || !(std::abs(body.inv_mass * body.mass - 1.0) < 1e-9))
     throw Error(label + ": mass must be positive and finite with inv_mass = 1/mass, got mass " +
-                std::to_string(body.mass));
+                format_number(body.mass));
   const Eigen::SelfAdjointEigenSolver<Mat3> eig(body.inertia_body);
   if (!all_finite(body.inertia_body) || !(eig.eigenvalues().minCoeff() > 0.0) ||
       !((body.inertia_body * body.inv_inertia_body - Mat3::Identity()).norm() < 1e-6))
     throw Error(label + ": inertia must be symmetric positive definite with a matching inverse");
+  // Finite values whose products are not: the energies and momenta every step measures.
+  const Vec3 momentum = body.mass * body.velocity;
+  const Vec3 spin = body.rotation * body.inertia_body * body.rotation.transpose() * body.angular_velocity;
+  if (!std::isfinite(momentum.dot(body.velocity)) || !std::isfinite(spin.dot(body.angular_velocity)) ||
+      !all_finite(body.position.cross(momentum)) || !std::isfinite(body.mass * body.position.norm()))
+    throw Error(label + ": mass " + format_number(body.mass) + ", position, velocity and angular velocity overflow "
+                "its kinetic energy or momentum (m |v|², ω·Iω, x × m v and m |x| must be finite)");
 }
 
 // The bodies a constraint joins and whether they still collide, whatever its kind.
@@ -84,7 +97,7 @@ void check_friction(CollisionResolver& resolver, const RigidBody& body, std::siz
   if (!(body.material.friction > 0.0)) return;
   if (ModuleStatus s = resolver.accept_friction(); !s)
     throw Error("resolver: " + s.message + ", but " + body_label(body, index) + " has friction " +
-                std::to_string(body.material.friction) +
+                format_number(body.material.friction) +
                 "; set its friction to 0 or choose a resolver (or mode) that models friction, such as ledas or mirtich");
 }
 
@@ -109,32 +122,56 @@ double prescribed_contact_work(std::span<const RigidBody> bodies, std::span<cons
 
 World::World(WorldSettings settings) : settings_(std::move(settings)) {
   if (!(settings_.dt > 0.0) || !std::isfinite(settings_.dt))
-    throw Error("world: dt must be positive and finite, got " + std::to_string(settings_.dt));
+    throw Error("world: dt must be positive and finite, got " + format_number(settings_.dt));
   if (!all_finite(settings_.gravity)) throw Error("world: gravity must be finite");
   const SleepSettings& sleep = settings_.sleep;
   if (!(sleep.linear_velocity >= 0.0) || !std::isfinite(sleep.linear_velocity))
-    throw Error("world: sleep linear_velocity must be finite and >= 0, got " + std::to_string(sleep.linear_velocity));
+    throw Error("world: sleep linear_velocity must be finite and >= 0, got " + format_number(sleep.linear_velocity));
   if (!(sleep.angular_velocity >= 0.0) || !std::isfinite(sleep.angular_velocity))
-    throw Error("world: sleep angular_velocity must be finite and >= 0, got " + std::to_string(sleep.angular_velocity));
+    throw Error("world: sleep angular_velocity must be finite and >= 0, got " + format_number(sleep.angular_velocity));
   if (!(sleep.time > 0.0) || !std::isfinite(sleep.time))
-    throw Error("world: sleep time must be positive and finite, got " + std::to_string(sleep.time));
+    throw Error("world: sleep time must be positive and finite, got " + format_number(sleep.time));
 }
 
 World::~World() = default;
 
-BodyIndex World::add_body(RigidBody body) {
-  validate_body(body, bodies_.size());
-  if (!body.name.empty() && find_body(body.name))
-    throw Error("body '" + body.name + "': a body with this name already exists");
-  if (resolver_) check_friction(*resolver_, body, bodies_.size());
-  if (body.asleep) throw Error(body_label(body, bodies_.size()) + ": 'asleep' is the world's to set; add bodies awake");
+void World::check_new_body(const RigidBody& body, std::size_t index) const {
+  validate_body(body, index);
+  if (resolver_) check_friction(*resolver_, body, index);
+  if (body.asleep) throw Error(body_label(body, index) + ": 'asleep' is the world's to set; add bodies awake");
+}
+
+void World::append_body(RigidBody body) {
   if (body.fixed) make_fixed(body);
   bodies_.push_back(std::move(body));
   handles_.push_back(BodyHandle{next_handle_++});
   still_time_.push_back(0.0);
   sleep_group_.push_back(static_cast<std::uint32_t>(bodies_.size() - 1));
   detector_stale_ = true;
+}
+
+BodyIndex World::add_body(RigidBody body) {
+  check_new_body(body, bodies_.size());
+  if (!body.name.empty() && find_body(body.name))
+    throw Error("body '" + body.name + "': a body with this name already exists");
+  append_body(std::move(body));
   return static_cast<BodyIndex>(bodies_.size() - 1);
+}
+
+BodyIndex World::add_bodies(std::vector<RigidBody> bodies) {
+  std::unordered_set<std::string_view> names;
+  names.reserve(bodies_.size() + bodies.size());
+  for (const RigidBody& b : bodies_)
+    if (!b.name.empty()) names.insert(b.name);
+  for (std::size_t i = 0; i < bodies.size(); ++i) {
+    check_new_body(bodies[i], bodies_.size() + i);
+    if (!bodies[i].name.empty() && !names.insert(bodies[i].name).second)
+      throw Error("body '" + bodies[i].name + "': a body with this name already exists");
+  }
+  const auto first = static_cast<BodyIndex>(bodies_.size());
+  bodies_.reserve(bodies_.size() + bodies.size());
+  for (RigidBody& b : bodies) append_body(std::move(b));
+  return first;
 }
 
 BodyHandle World::handle(BodyIndex index) const {

@@ -4,6 +4,7 @@
 #include "impetus/fclib/fclib.hpp"
 
 #include "impetus/core/error.hpp"
+#include "impetus/core/format.hpp"
 
 extern "C" {  // fclib.h declares C functions without saying so
 #include <fclib.h>
@@ -236,7 +237,7 @@ std::vector<double> friction(const std::filesystem::path& file, const double* da
   std::vector<double> mu(data, data + contacts);
   for (long long c = 0; c < contacts; ++c)
     if (!(mu[c] >= 0.0) || !std::isfinite(mu[c]))
-      fail(file, "mu[" + std::to_string(c) + "] is " + std::to_string(mu[c]) + " (a friction coefficient is finite and ≥ 0)");
+      fail(file, "mu[" + std::to_string(c) + "] is " + format_number(mu[c]) + " (a friction coefficient is finite and ≥ 0)");
   return mu;
 }
 
@@ -255,8 +256,8 @@ void check_symmetric(const std::filesystem::path& file, const std::string& name,
   const double scale = a.coeffs().cwiseAbs().maxCoeff();
   const double asymmetry = difference.nonZeros() > 0 ? difference.coeffs().cwiseAbs().maxCoeff() : 0.0;
   if (asymmetry > 1e-9 * scale)
-    fail(file, name + " is not symmetric (|" + name + " − " + name + "ᵀ| reaches " + std::to_string(asymmetry) +
-                   " against entries up to " + std::to_string(scale) + ")");
+    fail(file, name + " is not symmetric (|" + name + " − " + name + "ᵀ| reaches " + format_number(asymmetry) +
+                   " against entries up to " + format_number(scale) + ")");
 }
 
 // fclib's arrays of a compressed-column matrix (views into `a`, which must outlive them).

@@ -8,6 +8,7 @@
 /// returns, the host reports every option the plugin did not read as unknown, naming the plugin, the
 /// option and where it was written.
 
+#include "impetus/core/format.hpp"
 #include "impetus/core/math.hpp"
 
 #include <cerrno>
@@ -66,7 +67,7 @@ class ModuleOptions {
   double number(const std::string& key, double fallback, double lo, double hi) const {
     const double x = number(key, fallback);
     if (x < lo || x > hi)
-      fail(key, "must be between " + std::to_string(lo) + " and " + std::to_string(hi) + ", got " +
+      fail(key, "must be between " + format_number(lo) + " and " + format_number(hi) + ", got " +
                     values_.at(key).text);
     return x;
   }

@@ -40,6 +40,11 @@ struct Scene {
   std::vector<std::filesystem::path> plugin_path;  ///< extra plugin directories, highest precedence
   std::vector<RigidBody> bodies;
   std::vector<Constraint> constraints;
+  /// Where each body was written, or the generator that made it ("<file>:<line>:<col>"), and where
+  /// each constraint was, for errors found when the world is built (a resolver that refuses a body's
+  /// friction or a constraint); may be empty for a scene built in code.
+  std::vector<std::string> body_where;
+  std::vector<std::string> constraint_where;  ///< (see body_where)
   /// Load-time warnings, each "<file>:<line>:<col>: <what>" (e.g. a mesh wound inward and flipped, or
   /// converted from centimetres); the CLI prints them on stderr.
   std::vector<std::string> warnings;

@@ -101,7 +101,13 @@ class World {
   /// fixed ones and velocities on a fixed body only with one). Throws Error naming the body otherwise.
   /// The body's index is bodies().size() before the call; handle(index) gives its stable handle. May be
   /// called between steps: the detector is told before the next detection.
+  /// Checking the name against the bodies already in the world is a scan, so adding n bodies one by
+  /// one costs O(n²): use add_bodies for many.
   BodyIndex add_body(RigidBody body);
+  /// Adds many bodies at once, checked as add_body checks one (names against the world and each other
+  /// with a hash set, so the cost is linear); all or nothing: if one is refused, none is added. Returns
+  /// the index of the first (the others follow in order).
+  BodyIndex add_bodies(std::vector<RigidBody> bodies);
   /// Removes a body between steps, with the constraints that join it (returns how many). Later bodies'
   /// indices shift down by one, constraints are renumbered, the last contacts are cleared, the detector
   /// is told before the next detection and the resolver at once (CollisionResolver::bodies_removed).
@@ -167,6 +173,8 @@ class World {
   void kick_woken(StepStatus& status);
   void hold_sleepers();
   std::size_t remove_at(BodyIndex index);
+  void check_new_body(const RigidBody& body, std::size_t index) const;  // all add_body checks but the name
+  void append_body(RigidBody body);
 
   struct BodyState {
     Vec3 position;

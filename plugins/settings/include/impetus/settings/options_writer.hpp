@@ -3,26 +3,17 @@
 /// Writing typed settings back as module options (the text a scene would hold), so a settings struct
 /// built in code goes through the same plugin path, checks and run summary as a scene's options.
 
+#include "impetus/core/format.hpp"
 #include "impetus/modules/options.hpp"
 
-#include <array>
-#include <charconv>
 #include <string>
 
 namespace impetus::settings_detail {
 
-/// The shortest text that reads back as exactly `x` (std::to_chars), so settings survive the round trip
-/// bit for bit.
-inline std::string number_text(double x) {
-  std::array<char, 32> buffer{};
-  const auto result = std::to_chars(buffer.data(), buffer.data() + buffer.size(), x);
-  return std::string(buffer.data(), result.ptr);
-}
-
 /// Sets `key` in `options` when `value` differs from `fallback` (the plugin's default): the options list
 /// what was chosen, as a scene would.
 inline void put(ModuleOptions& options, const char* key, double value, double fallback) {
-  if (value != fallback) options.set(key, OptionValue{number_text(value), {}, false, "code"});
+  if (value != fallback) options.set(key, OptionValue{format_number(value), {}, false, "code"});
 }
 inline void put(ModuleOptions& options, const char* key, long long value, long long fallback) {
   if (value != fallback) options.set(key, OptionValue{std::to_string(value), {}, false, "code"});
