@@ -298,8 +298,9 @@ void check_data_uris(const std::filesystem::path& file, std::uintmax_t size) {
       }
       if (start == "data:" && total + raw > kMaxDataUriBytes)
         throw Error(file.string() + ": refers to '" + raw_start +
-                    "…', a data: URI that takes its data: URIs past the limit of " + std::to_string(kMaxDataUriBytes) +
-                    " bytes (64 MiB) of text in one file; put a large buffer in a file beside the mesh (or use .glb)");
+                    "…', a data: URI that brings the file's data: URIs past the limit of " +
+                    std::to_string(kMaxDataUriBytes) +
+                    " bytes (64 MiB) of text; put a large buffer in a file beside the mesh or in a .glb's binary chunk");
     }
   }
 }

@@ -186,10 +186,20 @@ TEST(MeshReference, OversizedDataUriIsRefused) {
   const fs::path mesh = f.write("mesh.gltf", cube_gltf(prefix + std::string(std::size_t{64} << 20, 'A')));
   const std::string error = error_of([&] { assets::load_mesh_body(mesh); });
   expect_refusal(error, mesh, "refers to 'data:application/octet-stream;base64,AAAAAAAAAAA");
-  expect_refusal(error, mesh, "a data: URI that takes its data: URIs past the limit of 67108864 bytes (64 MiB)");
+  expect_refusal(error, mesh, "a data: URI that brings the file's data: URIs past the limit of 67108864 bytes (64 MiB) of text");
   // Spelled with a JSON escape, it is the same URI to assimp's JSON parser, and to the check.
   const fs::path escaped = f.write("escaped.gltf", cube_gltf("d\\u0061" + prefix.substr(2) + std::string(std::size_t{64} << 20, 'A')));
   expect_refusal(error_of([&] { assets::load_mesh_body(escaped); }), escaped, "past the limit of 67108864 bytes");
+  // In a .glb, the JSON chunk is scanned (its length at byte 12, its text from byte 20).
+  std::string json = cube_gltf(prefix + std::string(std::size_t{64} << 20, 'A'));
+  json.append((4 - json.size() % 4) % 4, ' ');
+  const auto le32 = [](std::size_t n) {
+    std::string bytes;
+    for (int k = 0; k < 4; ++k) bytes.push_back(static_cast<char>((n >> (8 * k)) & 0xFF));
+    return bytes;
+  };
+  const fs::path glb = f.write("mesh.glb", "glTF" + le32(2) + le32(20 + json.size()) + le32(json.size()) + "JSON" + json);
+  expect_refusal(error_of([&] { assets::load_mesh_body(glb); }), glb, "a data: URI that brings the file's data: URIs past");
 }
 
 // --- Values that overflow ----------------------------------------------------------------------------
