@@ -30,6 +30,7 @@
 #include <array>
 #include <bit>
 #include <cerrno>
+#include <cstdint>
 #include <cmath>
 #include <limits>
 #include <optional>
@@ -137,7 +138,7 @@ class BoundedFile final : public Assimp::IOStream {
 
   std::size_t Read(void* buffer, std::size_t size, std::size_t count) override {
     if (size == 0 || count == 0 || count > std::numeric_limits<std::size_t>::max() / size) return 0;
-    const std::size_t want = std::min(size * count, size_ - position_);
+    const std::size_t want = position_ >= size_ ? 0 : std::min(size * count, size_ - position_);
     std::size_t got = 0;
     while (got < want) {
       const ssize_t n = ::pread(fd_, static_cast<char*>(buffer) + got, want - got,
@@ -150,13 +151,16 @@ class BoundedFile final : public Assimp::IOStream {
     return got / size;
   }
   std::size_t Write(const void*, std::size_t, std::size_t) override { return 0; }
+  // As assimp's own stream (fseek with the offset cast to long): relative offsets may be negative, a
+  // position before the start fails, one past the end is allowed and reads nothing.
   aiReturn Seek(std::size_t offset, aiOrigin origin) override {
-    std::size_t base = 0;
-    if (origin == aiOrigin_CUR) base = position_;
-    else if (origin == aiOrigin_END) base = size_;
+    std::int64_t base = 0;
+    if (origin == aiOrigin_CUR) base = static_cast<std::int64_t>(position_);
+    else if (origin == aiOrigin_END) base = static_cast<std::int64_t>(size_);
     else if (origin != aiOrigin_SET) return aiReturn_FAILURE;
-    if (offset > size_ - base) return aiReturn_FAILURE;  // assimp seeks forward only (size_t offsets)
-    position_ = base + offset;
+    const auto delta = static_cast<std::int64_t>(offset);
+    if (delta < -base || (delta > 0 && base > std::numeric_limits<std::int64_t>::max() - delta)) return aiReturn_FAILURE;
+    position_ = static_cast<std::size_t>(base + delta);
     return aiReturn_SUCCESS;
   }
   std::size_t Tell() const override { return position_; }

@@ -142,6 +142,15 @@ TEST(MeshReference, SymlinkOutOfTheFolderIsRefused) {
   expect_refusal(load_error(mesh), mesh, "refers to 'link.bin', a symbolic link to '" + f.outside.string() + "'");
 }
 
+TEST(MeshReference, ReferencedFileLargerThanTheBoundIsRefused) {
+  const Folders f;
+  const fs::path big = f.write("big.bin", cube_buffer());
+  fs::resize_file(big, (std::uintmax_t{1} << 30) + 1);  // sparse: nothing is written
+  const fs::path mesh = f.write("mesh.gltf", cube_gltf("big.bin"));
+  expect_refusal(load_error(mesh), mesh,
+                 "refers to 'big.bin', 1073741825 bytes, larger than the limit of 1073741824 bytes (1 GiB)");
+}
+
 TEST(MeshReference, BufferInsideTheFolderLoads) {
   const Folders f;
   f.write("cube.bin", cube_buffer());
