@@ -124,7 +124,6 @@ std::string unit_name(double metres) {
   return "";
 }
 
-
 namespace fs = std::filesystem;
 
 // A file opened for assimp: reads with pread from a descriptor, never past the size it had when opened
@@ -175,10 +174,12 @@ class BoundedFile final : public Assimp::IOStream {
 
 // assimp's file system for one mesh file: the mesh itself, and any file it refers to that lies inside
 // the mesh's folder tree after lexical normalisation and symbolic link resolution (weakly_canonical),
-// is a regular file and is at most detail::kMaxMeshBytes. Anything else is refused: Open returns null (assimp
+// is a regular file and is at most kMaxMeshBytes. Anything else is refused: Open returns null (assimp
 // then fails, or goes on without the file) and the first refusal is kept, so that read_with_assimp
 // throws it whatever assimp made of the missing file. Exists answers false outside the folder, without
 // a refusal: importers probe optional files (an OBJ's material library, a Quake 3 shader) that way.
+// The check is on names: a folder that another process changes between the check and the open is not
+// covered (the mesh's folder is trusted not to change under the import).
 class FolderIO final : public Assimp::IOSystem {
  public:
   explicit FolderIO(const fs::path& mesh) : mesh_(mesh.string()) {
