@@ -12,7 +12,9 @@
 #include <Eigen/Eigenvalues>
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
@@ -35,13 +37,35 @@ namespace fs = std::filesystem;
   std::abort();
 }
 
-// A private directory for the mesh files, removed when the process exits normally.
+constexpr const char* kBufferName = "buffer.bin";
+
+// The unit cube [0, 1]³ as glTF buffer bytes (240): 36 uint32 indices (outward), then 8 float32 vertices,
+// little-endian; the seeds fuzz/corpus/mesh_gltf/cube_external_buffer.gltf and
+// fuzz/corpus/mesh_glb/cube_external_buffer.glb refer to it.
+std::string cube_buffer() {
+  const std::uint32_t indices[36] = {0, 1, 2, 0, 2, 3, 4, 5, 6, 4, 6, 7, 0, 3, 5, 0, 5, 4,
+                                     1, 7, 6, 1, 6, 2, 0, 4, 7, 0, 7, 1, 3, 2, 6, 3, 6, 5};
+  const float vertices[24] = {0, 0, 0, 0, 1, 0, 1, 1, 0, 1, 0, 0, 0, 0, 1, 1, 0, 1, 1, 1, 1, 0, 1, 1};
+  std::string bytes;
+  for (const std::uint32_t i : indices)
+    for (int k = 0; k < 4; ++k) bytes.push_back(static_cast<char>((i >> (8 * k)) & 0xFF));
+  for (const float v : vertices) {
+    const auto bits = std::bit_cast<std::uint32_t>(v);
+    for (int k = 0; k < 4; ++k) bytes.push_back(static_cast<char>((bits >> (8 * k)) & 0xFF));
+  }
+  return bytes;
+}
+
+// A private directory for the mesh files (and buffer.bin), removed when the process exits normally.
 class ScratchDir {
  public:
   ScratchDir() {
     std::error_code ec;
     path_ = fs::temp_directory_path(ec) / ("impetus-fuzz-" + std::to_string(getpid()));
     fs::create_directories(path_, ec);
+    // A file a glTF input can refer to ("uri": "buffer.bin"), so the fuzzers reach reference resolution
+    // with a reference that resolves, beside the ones that climb out ("../buffer.bin") and are refused.
+    std::ofstream(path_ / kBufferName, std::ios::binary) << cube_buffer();
   }
   ~ScratchDir() {
     std::error_code ec;

@@ -28,7 +28,10 @@ Outcome scene_one_input(const std::uint8_t* data, std::size_t size);
 Outcome overrides_one_input(const std::uint8_t* data, std::size_t size);
 
 /// The mesh pipeline: `data` is written to a private temporary file named `input.<extension>`
-/// (extension without the dot: obj, stl, ply, off, gltf, glb, dae) and imported, validated, given mass
+/// (extension without the dot: obj, stl, ply, off, gltf, glb, dae) in a folder that also holds
+/// `buffer.bin` (a unit cube's glTF buffer: 36 uint32 indices, then 8 float32 vertices), so that an input
+/// can refer to a file that resolves (and to others, outside the folder, that must be refused), and
+/// imported, validated, given mass
 /// properties and a convex hull (assets::load_mesh_body). An accepted mesh must have a positive finite
 /// volume and a finite, symmetric, positive definite inertia that satisfies the triangle inequality.
 Outcome mesh_one_input(const std::uint8_t* data, std::size_t size, const std::string& extension);

@@ -5,12 +5,21 @@
 // in double precision (aiProcess_PreTransformVertices would merge meshes by material and lose the
 // parts), convert units, and weld vertices on exact equality (see mesh_import.hpp for why not
 // aiProcess_JoinIdenticalVertices).
+// Every file assimp opens goes through FolderIO below: the mesh file itself, and the files it refers to
+// (glTF buffers, OBJ material libraries, …) only inside the mesh's own folder tree.
 
 #include "assimp_reader.hpp"
 
 #include "impetus/core/error.hpp"
+#include "mesh_file_checks.hpp"
 #include "text.hpp"
 
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <assimp/IOStream.hpp>
+#include <assimp/IOSystem.hpp>
 #include <assimp/Importer.hpp>
 #include <assimp/commonMetaData.h>
 #include <assimp/config.h>
@@ -20,7 +29,11 @@
 
 #include <array>
 #include <bit>
+#include <cerrno>
+#include <cstdint>
 #include <cmath>
+#include <limits>
+#include <optional>
 #include <unordered_map>
 
 namespace impetus::assets {
@@ -111,6 +124,172 @@ std::string unit_name(double metres) {
   return "";
 }
 
+namespace fs = std::filesystem;
+
+// A file opened for assimp: reads with pread from a descriptor, never past the size it had when opened
+// (so a file that grows while assimp reads it cannot take more than the bound it was checked against).
+class BoundedFile final : public Assimp::IOStream {
+ public:
+  BoundedFile(int fd, std::size_t size) : fd_(fd), size_(size) {}
+  ~BoundedFile() override { ::close(fd_); }
+  BoundedFile(const BoundedFile&) = delete;
+  BoundedFile& operator=(const BoundedFile&) = delete;
+
+  std::size_t Read(void* buffer, std::size_t size, std::size_t count) override {
+    if (size == 0 || count == 0 || count > std::numeric_limits<std::size_t>::max() / size) return 0;
+    const std::size_t want = position_ >= size_ ? 0 : std::min(size * count, size_ - position_);
+    std::size_t got = 0;
+    while (got < want) {
+      const ssize_t n = ::pread(fd_, static_cast<char*>(buffer) + got, want - got,
+                                static_cast<off_t>(position_ + got));
+      if (n < 0 && errno == EINTR) continue;
+      if (n <= 0) break;
+      got += static_cast<std::size_t>(n);
+    }
+    position_ += got;
+    return got / size;
+  }
+  std::size_t Write(const void*, std::size_t, std::size_t) override { return 0; }
+  // As assimp's own stream (fseek with the offset cast to long): relative offsets may be negative, a
+  // position before the start fails, one past the end is allowed and reads nothing.
+  aiReturn Seek(std::size_t offset, aiOrigin origin) override {
+    std::int64_t base = 0;
+    if (origin == aiOrigin_CUR) base = static_cast<std::int64_t>(position_);
+    else if (origin == aiOrigin_END) base = static_cast<std::int64_t>(size_);
+    else if (origin != aiOrigin_SET) return aiReturn_FAILURE;
+    const auto delta = static_cast<std::int64_t>(offset);
+    if (delta < -base || (delta > 0 && base > std::numeric_limits<std::int64_t>::max() - delta)) return aiReturn_FAILURE;
+    position_ = static_cast<std::size_t>(base + delta);
+    return aiReturn_SUCCESS;
+  }
+  std::size_t Tell() const override { return position_; }
+  std::size_t FileSize() const override { return size_; }
+  void Flush() override {}
+
+ private:
+  int fd_;
+  std::size_t size_;
+  std::size_t position_ = 0;
+};
+
+// assimp's file system for one mesh file: the mesh itself, and any file it refers to that lies inside
+// the mesh's folder tree after lexical normalisation and symbolic link resolution (weakly_canonical),
+// is a regular file and is at most kMaxMeshBytes. Anything else is refused: Open returns null (assimp
+// then fails, or goes on without the file) and the first refusal is kept, so that read_with_assimp
+// throws it whatever assimp made of the missing file. Exists answers false outside the folder, without
+// a refusal: importers probe optional files (an OBJ's material library, a Quake 3 shader) that way.
+// The check is on names: a folder that another process changes between the check and the open is not
+// covered (the mesh's folder is trusted not to change under the import).
+class FolderIO final : public Assimp::IOSystem {
+ public:
+  explicit FolderIO(const fs::path& mesh) : mesh_(mesh.string()) {
+    std::error_code ec;
+    const fs::path absolute = fs::absolute(mesh, ec);
+    mesh_canonical_ = fs::weakly_canonical(absolute, ec);
+    root_ = fs::weakly_canonical(absolute.parent_path(), ec);
+    // What assimp puts before a name the file gives: the mesh's path up to its last separator.
+    const std::size_t slash = mesh_.find_last_of('/');
+    prefix_ = slash == std::string::npos ? std::string() : mesh_.substr(0, slash + 1);
+  }
+
+  bool Exists(const char* path) const override {
+    if (!path) return false;
+    const Resolved r = resolve(path);
+    std::error_code ec;
+    return !r.refusal && fs::exists(r.path, ec);
+  }
+  char getOsSeparator() const override { return '/'; }
+
+  Assimp::IOStream* Open(const char* path, const char* mode) override {
+    if (!path) return nullptr;
+    const std::string name = written(path);
+    if (mode && std::string_view(mode).find_first_of("wa+") != std::string_view::npos) {
+      refuse("asks to write '" + name + "'; mesh import only reads");
+      return nullptr;
+    }
+    const Resolved r = resolve(path);
+    if (r.refusal) {
+      refuse(*r.refusal);
+      return nullptr;
+    }
+    // O_NONBLOCK: opening a FIFO must not wait for a writer (it is refused just below).
+    const int fd = ::open(r.path.c_str(), O_RDONLY | O_CLOEXEC | O_NOCTTY | O_NONBLOCK);
+    if (fd < 0) return nullptr;  // missing or unreadable: assimp says so, naming the file
+    struct stat info {};
+    if (::fstat(fd, &info) != 0 || !S_ISREG(info.st_mode)) {
+      ::close(fd);
+      refuse("refers to '" + name + "', which is " +
+             (S_ISDIR(info.st_mode) ? "a directory" : "not a regular file (a device, pipe or socket)") +
+             ", not a file a mesh can refer to");
+      return nullptr;
+    }
+    const auto size = static_cast<std::uintmax_t>(info.st_size);
+    if (size > detail::kMaxMeshBytes) {
+      ::close(fd);
+      refuse("refers to '" + name + "', " + std::to_string(size) + " bytes, larger than the limit of " +
+             std::to_string(detail::kMaxMeshBytes) + " bytes (1 GiB) for a file a mesh refers to");
+      return nullptr;
+    }
+    return new BoundedFile(fd, static_cast<std::size_t>(size));
+  }
+  void Close(Assimp::IOStream* file) override { delete file; }
+
+  const std::optional<std::string>& refusal() const { return refusal_; }
+
+ private:
+  struct Resolved {
+    fs::path path;
+    std::optional<std::string> refusal;
+  };
+
+  // The name as the mesh file wrote it: assimp's path with the mesh's folder prefix taken off.
+  std::string written(const std::string& path) const {
+    if (!prefix_.empty() && path.size() > prefix_.size() && path.compare(0, prefix_.size(), prefix_) == 0)
+      return path.substr(prefix_.size());
+    return path;
+  }
+
+  static bool inside(const fs::path& path, const fs::path& root) {
+    auto p = path.begin();
+    for (auto r = root.begin(); r != root.end(); ++r, ++p)
+      if (p == path.end() || *p != *r) return false;
+    return true;
+  }
+
+  Resolved resolve(const std::string& path) const {
+    std::error_code ec;
+    if (path == mesh_) return {mesh_canonical_, std::nullopt};
+    const fs::path absolute = fs::absolute(path, ec);
+    const fs::path canonical = fs::weakly_canonical(absolute, ec);
+    if (!ec && canonical == mesh_canonical_) return {canonical, std::nullopt};
+    const std::string name = written(path);
+    // An absolute name in the file: assimp puts the mesh's folder before it ("dir//etc/passwd"), which
+    // would stay inside; what the file meant is refused.
+    const bool absolute_name = !name.empty() && name.front() == '/';
+    if (absolute_name && name != path)
+      return {{}, "refers to '" + name + "', an absolute path; a mesh may refer only to files inside its own folder"};
+    if (ec || root_.empty())
+      return {{}, "refers to '" + name + "', which cannot be resolved (" + ec.message() + ")"};
+    if (inside(canonical, root_)) return {canonical, std::nullopt};
+    if (absolute_name)
+      return {{}, "refers to '" + name + "', an absolute path outside the mesh's folder '" + root_.string() + "'"};
+    if (inside(absolute.lexically_normal(), root_))
+      return {{}, "refers to '" + name + "', a symbolic link to '" + canonical.string() +
+                      "', outside the mesh's folder '" + root_.string() + "'"};
+    return {{}, "refers to '" + name + "', outside the mesh's folder '" + root_.string() + "'"};
+  }
+
+  void refuse(std::string why) {
+    if (!refusal_) refusal_ = mesh_ + ": " + std::move(why);
+  }
+
+  std::string mesh_;
+  std::string prefix_;
+  fs::path mesh_canonical_;
+  fs::path root_;
+  std::optional<std::string> refusal_;
+};
+
 }  // namespace
 
 void weld_identical_vertices(TriangleMesh& mesh) {
@@ -184,6 +363,8 @@ void finish_import(ImportedMesh& out, std::size_t dropped, const ImportOptions& 
 ImportedMesh read_with_assimp(const std::filesystem::path& file, const ImportOptions& options) {
   const std::string label = file.string();
   Assimp::Importer importer;
+  auto* io = new FolderIO(file);  // the importer owns it
+  importer.SetIOHandler(io);
   // Keep the file's axes: a Z-up COLLADA file stays Z-up (the engine's convention too).
   importer.SetPropertyBool(AI_CONFIG_IMPORT_COLLADA_IGNORE_UP_DIRECTION, true);
   importer.SetPropertyBool(AI_CONFIG_IMPORT_NO_SKELETON_MESHES, true);
@@ -191,8 +372,11 @@ ImportedMesh read_with_assimp(const std::filesystem::path& file, const ImportOpt
   try {
     scene = importer.ReadFile(file.string(), aiProcess_Triangulate | aiProcess_ValidateDataStructure);
   } catch (const std::exception& e) {
+    if (io->refusal()) throw Error(*io->refusal());
     throw Error(label + ": assimp failed to read it: " + e.what());
   }
+  // A refused reference is an error even when assimp went on without the file (an image, say).
+  if (io->refusal()) throw Error(*io->refusal());
   if (!scene || !scene->mRootNode)
     throw Error(label + ": assimp cannot read it: " + std::string(importer.GetErrorString()));
 

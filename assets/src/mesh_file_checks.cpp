@@ -8,6 +8,7 @@
 #include "impetus/core/error.hpp"
 #include "text.hpp"
 
+#include <algorithm>
 #include <array>
 #include <cctype>
 #include <cstring>
@@ -18,10 +19,6 @@
 
 namespace impetus::assets::detail {
 namespace {
-
-// Larger files are refused before assimp reads them: assimp holds the whole file and its scene graph in
-// memory (about 20 million triangles of binary STL fit below this).
-constexpr std::uintmax_t kMaxMeshBytes = std::uintmax_t{1} << 30;
 
 // assimp's message for a truncated binary STL ("Failed to determine STL storage representation") does
 // not say what is wrong; the header says how long the file must be, so check it first.
@@ -231,6 +228,83 @@ void check_collada(const std::filesystem::path& file, std::uintmax_t size) {
   }
 }
 
+// glTF `data:` URIs: assimp decodes each one into memory from the file's text, so they are bounded here,
+// together, by kMaxDataUriBytes. The text scanned is a file whose first non-blank byte is '{' (JSON,
+// whatever its extension: assimp also recognises a glTF by its content) or the JSON chunk of a binary
+// glTF ('glTF' magic; version 1 and 2 alike put its length at byte 12 and its text at byte 20). Every
+// JSON string is decoded as far as its first five characters (escapes included, so `"d\u0061ta:…"` is
+// counted too), and the raw length of those that start "data:" (in any case) is summed.
+void check_data_uris(const std::filesystem::path& file, std::uintmax_t size) {
+  std::ifstream in(file, std::ios::binary);
+  std::array<char, 20> head{};
+  in.read(head.data(), head.size());
+  const auto got = static_cast<std::uintmax_t>(in.gcount());
+  std::uintmax_t begin = 0, length = size;
+  if (got == head.size() && std::memcmp(head.data(), "glTF", 4) == 0) {
+    std::uint32_t json = 0;  // little-endian uint32
+    for (int k = 3; k >= 0; --k) json = (json << 8) | static_cast<unsigned char>(head[12 + k]);
+    begin = 20;
+    length = std::min<std::uintmax_t>(json, size - 20);
+  } else {
+    std::uintmax_t at = 0;
+    if (got >= 3 && std::memcmp(head.data(), "\xEF\xBB\xBF", 3) == 0) at = 3;  // UTF-8 byte order mark
+    while (at < got && std::isspace(static_cast<unsigned char>(head[at]))) ++at;
+    if (at == got || head[at] != '{') return;  // not JSON (a JSON file starting with 20 blanks: not a mesh)
+  }
+  in.clear();
+  in.seekg(static_cast<std::streamoff>(begin));
+
+  bool in_string = false, escape = false;
+  int hex_left = 0;
+  unsigned hex_value = 0;
+  std::string start;         // the string's first decoded characters, lower case (five at most)
+  std::string raw_start;     // its first raw characters, for the message
+  std::uintmax_t raw = 0;    // the string's raw length so far
+  std::uintmax_t total = 0;  // raw length of the data: URIs ended so far
+  const auto decoded = [&](unsigned c) {
+    if (start.size() < 5) start.push_back(static_cast<char>(c < 128 ? std::tolower(static_cast<int>(c)) : 0x80));
+  };
+  std::vector<char> buffer(std::size_t{1} << 20);
+  for (std::uintmax_t left = length; left > 0 && in;) {
+    in.read(buffer.data(), static_cast<std::streamsize>(std::min<std::uintmax_t>(left, buffer.size())));
+    const auto n = static_cast<std::size_t>(in.gcount());
+    if (n == 0) break;
+    left -= n;
+    for (std::size_t i = 0; i < n; ++i) {
+      const char c = buffer[i];
+      if (!in_string) {
+        if (c == '"') in_string = true, escape = false, hex_left = 0, start.clear(), raw_start.clear(), raw = 0;
+        continue;
+      }
+      if (!escape && hex_left == 0 && c == '"') {
+        in_string = false;
+        if (start == "data:") total += raw;
+        continue;
+      }
+      ++raw;
+      if (raw_start.size() < 48) raw_start.push_back(c);
+      if (hex_left > 0) {
+        const unsigned char u = static_cast<unsigned char>(c);
+        hex_value = hex_value * 16 + static_cast<unsigned>(std::isdigit(u) ? u - '0' : (std::tolower(u) - 'a' + 10) & 15);
+        if (--hex_left == 0) decoded(hex_value);
+      } else if (escape) {
+        escape = false;
+        if (c == 'u') hex_left = 4, hex_value = 0;
+        else decoded(static_cast<unsigned char>(c));
+      } else if (c == '\\') {
+        escape = true;
+      } else {
+        decoded(static_cast<unsigned char>(c));
+      }
+      if (start == "data:" && total + raw > kMaxDataUriBytes)
+        throw Error(file.string() + ": refers to '" + raw_start +
+                    "…', a data: URI that brings the file's data: URIs past the limit of " +
+                    std::to_string(kMaxDataUriBytes) +
+                    " bytes (64 MiB) of text; put a large buffer in a file beside the mesh or in a .glb's binary chunk");
+    }
+  }
+}
+
 }  // namespace
 
 std::uintmax_t check_mesh_file(const std::filesystem::path& file) {
@@ -252,6 +326,7 @@ std::uintmax_t check_mesh_file(const std::filesystem::path& file) {
   check_ply(file, size);
   check_off(file, size);
   check_collada(file, size);
+  check_data_uris(file, size);
   return size;
 }
 

@@ -4,9 +4,11 @@
 #include "mass_command.hpp"
 
 #include "impetus/assets/mesh_body.hpp"
+#include "impetus/core/error.hpp"
 
 #include <nlohmann/json.hpp>
 
+#include <cmath>
 #include <cstdio>
 #include <iostream>
 
@@ -41,15 +43,38 @@ CLI::App* add_mass_command(CLI::App& app, MassArgs& args) {
   return cmd;
 }
 
+namespace {
+
+// A value that overflows, named as the option that gave it ("--scale 1e+70 is too large: …").
+[[noreturn]] void rethrow_as_option(const assets::MassOverflow& e) {
+  switch (e.cause()) {
+    case assets::MassOverflow::Cause::scale: throw Error(e.message_naming("--scale"));
+    case assets::MassOverflow::Cause::density: throw Error(e.message_naming("--density"));
+    case assets::MassOverflow::Cause::mass: throw Error(e.message_naming("--mass"));
+  }
+  throw Error(e.what());
+}
+
+}  // namespace
+
 int run_mass_command(const MassArgs& args) {
   assets::ImportOptions options;
   options.scale = args.scale;
-  const assets::MeshBody body = assets::load_mesh_body(args.mesh, options, args.part);
-  for (const std::string& w : body.warnings) std::cerr << "impetus: warning: " << w << "\n";
-  assets::MassProperties p = body.unit;
-  if (args.density) p = assets::with_mass(p, *args.density * p.volume);
-  if (args.mass) p = assets::with_mass(p, *args.mass);
+  assets::MeshBody body;
+  assets::MassProperties p;
+  const std::string label = args.mesh + (args.part.empty() ? "" : " (part '" + args.part + "')");
+  try {
+    body = assets::load_mesh_body(args.mesh, options, args.part);
+    p = assets::mesh_mass_properties(body, args.density, args.mass, label);
+  } catch (const assets::MassOverflow& e) {
+    rethrow_as_option(e);
+  }
   const Vec3& com = body.center_of_mass_file;  // the body frame's origin, in file coordinates
+  // Nothing that is not a number is ever printed (the library refuses it; this is the last guard).
+  if (!(std::isfinite(p.volume) && std::isfinite(p.mass) && std::isfinite(p.density) && p.inertia.allFinite() &&
+        p.principal_moments.allFinite() && p.principal_axes.allFinite() && com.allFinite()))
+    throw Error(label + ": its mass properties are not finite numbers; nothing is printed");
+  for (const std::string& w : body.warnings) std::cerr << "impetus: warning: " << w << "\n";
 
   if (args.json) {
     nlohmann::json j;
