@@ -2,7 +2,10 @@
 
 #include <algorithm>
 #include <cmath>
+#include <array>
 #include <type_traits>
+#include <utility>
+#include <variant>
 
 namespace impetus::ledas {
 namespace {
@@ -108,6 +111,38 @@ std::string constraint_problem(const Constraint& constraint) {
         return {};
       },
       constraint);
+}
+
+std::vector<char> duplicate_constraints(std::span<const Constraint> constraints) {
+  using Key = std::array<double, 18>;  // kind, bodies, anchors, axes, length, level
+  const auto key = [](const Constraint& c) {
+    Key k{};
+    k[0] = static_cast<double>(c.index());
+    const auto put = [&k](std::size_t at, const Vec3& v) { k[at] = v.x(), k[at + 1] = v.y(), k[at + 2] = v.z(); };
+    std::visit(
+        [&](const auto& j) {
+          k[1] = static_cast<double>(j.a);
+          k[2] = static_cast<double>(j.b);
+          put(3, j.anchor_a);
+          put(6, j.anchor_b);
+          k[9] = static_cast<double>(j.level);
+          if constexpr (std::is_same_v<std::decay_t<decltype(j)>, CoaxialConstraint>) {
+            put(10, j.axis_a);
+            put(13, j.axis_b);
+            k[16] = j.length;
+          }
+        },
+        c);
+    return k;
+  };
+  std::vector<char> duplicate(constraints.size(), 0);
+  if (constraints.size() < 2) return duplicate;
+  std::vector<std::pair<Key, std::size_t>> keyed(constraints.size());
+  for (std::size_t i = 0; i < constraints.size(); ++i) keyed[i] = {key(constraints[i]), i};
+  std::sort(keyed.begin(), keyed.end());  // equal keys by index: the first copy comes first
+  for (std::size_t i = 1; i < keyed.size(); ++i)
+    if (keyed[i].first == keyed[i - 1].first) duplicate[keyed[i].second] = 1;
+  return duplicate;
 }
 
 }  // namespace impetus::ledas
