@@ -3,6 +3,9 @@
 #include <algorithm>
 #include <cmath>
 #include <array>
+#include <bit>
+#include <cstdint>
+#include <unordered_set>
 #include <type_traits>
 #include <utility>
 #include <variant>
@@ -137,11 +140,18 @@ std::vector<char> duplicate_constraints(std::span<const Constraint> constraints)
   };
   std::vector<char> duplicate(constraints.size(), 0);
   if (constraints.size() < 2) return duplicate;
-  std::vector<std::pair<Key, std::size_t>> keyed(constraints.size());
-  for (std::size_t i = 0; i < constraints.size(); ++i) keyed[i] = {key(constraints[i]), i};
-  std::sort(keyed.begin(), keyed.end());  // equal keys by index: the first copy comes first
-  for (std::size_t i = 1; i < keyed.size(); ++i)
-    if (keyed[i].first == keyed[i - 1].first) duplicate[keyed[i].second] = 1;
+  // Hashed: a thousand identical keys cost a thousand hashes and comparisons, not a sort's worth.
+  struct Hash {
+    std::size_t operator()(const Key& k) const {
+      std::uint64_t h = 0xcbf29ce484222325ull;  // FNV-1a over the values' bits
+      for (const double v : k) h = (h ^ std::bit_cast<std::uint64_t>(v == 0.0 ? 0.0 : v)) * 0x100000001b3ull;
+      return static_cast<std::size_t>(h);
+    }
+  };
+  std::unordered_set<Key, Hash> seen;
+  seen.reserve(constraints.size());
+  for (std::size_t i = 0; i < constraints.size(); ++i)
+    if (!seen.insert(key(constraints[i])).second) duplicate[i] = 1;  // an earlier copy is in
   return duplicate;
 }
 
