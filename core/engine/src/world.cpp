@@ -294,6 +294,10 @@ void World::detect(StepStatus& status) {
       while (wake_touched(status)) {
         contacts_.clear();
         detector_->detect(bodies_, context(), contacts_, status.detector);
+        if (refused_detection(status)) {
+          status.profile.detect = seconds_since(start);
+          return;
+        }
       }
       if (stepping_ && !woken_now_.empty()) kick_woken(status);
       // Whatever detector is in use, contacts between quiet bodies (asleep, or fixed at rest) go nowhere.
