@@ -35,9 +35,22 @@ class BodyObject final : public fcl::CollisionObjectd {
   BodyIndex index_;
 };
 
+// Where the callback appends, and when it stops: at `limit` pairs it records that it stopped and tells
+// FCL to end the traversal (returning true), so a pathological scene never allocates every pair.
+struct PairSink {
+  std::vector<BodyPair>* pairs;
+  std::size_t limit;
+  bool stopped = false;
+};
+
 bool record_pair(fcl::CollisionObjectd* o1, fcl::CollisionObjectd* o2, void* data) {
+  auto& sink = *static_cast<PairSink*>(data);
+  if (sink.pairs->size() >= sink.limit) {
+    sink.stopped = true;
+    return true;  // done: the caller refuses the detection
+  }
   const BodyIndex i = static_cast<BodyObject*>(o1)->index(), j = static_cast<BodyObject*>(o2)->index();
-  static_cast<std::vector<BodyPair>*>(data)->emplace_back(std::min(i, j), std::max(i, j));
+  sink.pairs->emplace_back(std::min(i, j), std::max(i, j));
   return false;  // keep going: we want every pair
 }
 
@@ -82,13 +95,15 @@ void Broadphase::move(BodyIndex index, const Aabb& box, double slack) {
   impl_->moved.push_back(object);
 }
 
-void Broadphase::collect(std::vector<BodyPair>& pairs) {
+bool Broadphase::collect(std::vector<BodyPair>& pairs, std::size_t limit) {
   if (!impl_->moved.empty()) {
     impl_->movable.update(impl_->moved);  // incremental: re-inserts only leaves that left their box
     impl_->moved.clear();
   }
-  impl_->movable.collide(&pairs, &record_pair);
-  if (!impl_->fixed.empty()) impl_->movable.collide(&impl_->fixed, &pairs, &record_pair);
+  PairSink sink{&pairs, limit};
+  impl_->movable.collide(&sink, &record_pair);
+  if (!sink.stopped && !impl_->fixed.empty()) impl_->movable.collide(&impl_->fixed, &sink, &record_pair);
+  return !sink.stopped;
 }
 
 }  // namespace impetus::collision

@@ -8,6 +8,8 @@
 #include "impetus/detection/fcl/shapes.hpp"
 
 #include <algorithm>
+#include <limits>
+#include <unordered_map>
 #include <chrono>
 #include <cmath>
 #include <exception>
@@ -208,7 +210,27 @@ void FclDetector::detect(std::span<const RigidBody> bodies, const StepContext& /
     s.boxes[i] = grown(world_aabb(body), 0.5 * margin);
     s.broadphase.move(i, s.boxes[i], 0.05 * body.size());
   }
-  s.broadphase.collect(s.pairs);
+  // Candidate pairs are bounded by work: many bodies generated at one point would give n²/2 of them (and
+  // up to four contacts each). Past the limit the detection is refused, naming the most crowded body.
+  const std::size_t pair_limit = s.settings.max_pairs_per_body == 0
+                                     ? std::numeric_limits<std::size_t>::max()
+                                     : std::max<std::size_t>(FclDetectorSettings::kMinPairLimit,
+                                                             static_cast<std::size_t>(s.settings.max_pairs_per_body) *
+                                                                 s.movable.size());
+  if (!s.broadphase.collect(s.pairs, pair_limit)) {
+    std::unordered_map<BodyIndex, std::uint64_t> count;
+    for (const auto& [a, b] : s.pairs) ++count[a], ++count[b];
+    std::pair<BodyIndex, std::uint64_t> crowded{0, 0};
+    for (const auto& [body, n] : count)
+      if (n > crowded.second || (n == crowded.second && body < crowded.first)) crowded = {body, n};
+    counters.pairs_tested += s.pairs.size();
+    counters.pair_limit = pair_limit;
+    counters.crowded_body = crowded.first;
+    counters.crowded_pairs = crowded.second;
+    s.pairs.clear();
+    s.profile.broadphase = seconds(start, Clock::now());
+    return;
+  }
   for (BodyIndex p : s.planes) {
     const WorldPlane plane = world_plane(s.placed(bodies[p], p));
     const bool plane_quiet = quiet(bodies[p]);

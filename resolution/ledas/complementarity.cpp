@@ -222,8 +222,10 @@ Vector ComplementaritySolver::solve(const ComplementarityProblem& problem, Solve
   }
   Search search(problem, settings_, scale, std::move(free_rows));
   search.loop.factor = checkout_masked(a, search.free_rows, stats);
-  for (std::uint64_t iteration = 0; iteration < settings_.max_iterations && !search.done(); ++iteration)
+  const std::uint64_t budget = work_budget(m, settings_);
+  for (std::uint64_t iteration = 0; iteration < budget && !search.done(); ++iteration)
     iterate(search, iteration, stats);
+  if (!search.done() && budget < settings_.max_iterations) ++stats.work_limited;
   checkin_masked(std::move(search.loop.factor));
   // Redundant rows met in the search: solved (a redundant contact set) when the search converged; when
   // it stalled the minimum-norm fallback below counts its own systems; hitting the cap is a failure.

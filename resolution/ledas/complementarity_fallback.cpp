@@ -83,7 +83,8 @@ Vector ComplementaritySolver::solve_min_norm(const ComplementarityProblem& probl
   for (std::size_t k = 0; k < m; ++k) free_rows[k] = problem.equality[k] || problem.start[k];
   Vector p = Vector::Zero(a.rows());
   bool converged = false, not_finite = false, infeasible = false;
-  for (std::uint64_t iteration = 0; iteration < settings_.max_iterations; ++iteration) {
+  const std::uint64_t budget = work_budget(m, settings_);
+  for (std::uint64_t iteration = 0; iteration < budget; ++iteration) {
     ++stats.iterations;
     const std::uint64_t singular_before = stats.singular;
     const Vector z = min_norm_on_free_set(equalities_, a, problem.rhs, free_rows, stats);
@@ -120,7 +121,10 @@ Vector ComplementaritySolver::solve_min_norm(const ComplementarityProblem& probl
       break;
     }
   }
-  if (!converged && !not_finite && !infeasible) ++stats.non_converged;
+  if (!converged && !not_finite && !infeasible) {
+    ++stats.non_converged;
+    if (budget < settings_.max_iterations) ++stats.work_limited;
+  }
   clamp_to_free_set(p, free_rows, problem.equality);
   return p;
 }

@@ -17,6 +17,7 @@ void LedasResolver::velocity_complementary(ledas::Island& island, std::span<Rigi
   problem.equality = island.equality;
   problem.start.resize(m);
   problem.tolerance = settings_.tolerance;
+  const std::uint64_t failed_before = stats_.velocity.infeasible, unconverged_before = stats_.velocity.non_converged;
   for (std::uint64_t round = 0;; ++round) {
     const Vector& v = current_velocities(island, bodies);  // (finish_round changes it: not used after)
     bool needed = ledas::retarget_joints(island, rows_, info_, v, bodies) && round > 0;
@@ -35,10 +36,14 @@ void LedasResolver::velocity_complementary(ledas::Island& island, std::span<Rigi
       if (touching) island.entered[i] = 1;
     }
     if (!needed) break;
-    if (round == settings_.max_rounds) {
+    // Rounds are bounded by work too: a round repeats only because restitution made a contact approach
+    // again; one whose solve failed (no solution, or stopped unconverged) would fail the same way again.
+    if (round == settings_.max_rounds || round == ledas::work_budget(m, solver_.settings())) {
       ++counters.non_converged;
       break;
     }
+    if (round > 0 && (stats_.velocity.infeasible > failed_before || stats_.velocity.non_converged > unconverged_before))
+      break;  // counted by the solver already
     if (settings_.start_set == LedasStartSet::impact) narrow_start_set(island, v, problem.start);
     problem.rhs = target - v;
     const std::uint64_t before = stats_.velocity.iterations;

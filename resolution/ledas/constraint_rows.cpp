@@ -2,7 +2,13 @@
 
 #include <algorithm>
 #include <cmath>
+#include <array>
+#include <bit>
+#include <cstdint>
+#include <unordered_set>
 #include <type_traits>
+#include <utility>
+#include <variant>
 
 namespace impetus::ledas {
 namespace {
@@ -108,6 +114,45 @@ std::string constraint_problem(const Constraint& constraint) {
         return {};
       },
       constraint);
+}
+
+std::vector<char> duplicate_constraints(std::span<const Constraint> constraints) {
+  using Key = std::array<double, 18>;  // kind, bodies, anchors, axes, length, level
+  const auto key = [](const Constraint& c) {
+    Key k{};
+    k[0] = static_cast<double>(c.index());
+    const auto put = [&k](std::size_t at, const Vec3& v) { k[at] = v.x(), k[at + 1] = v.y(), k[at + 2] = v.z(); };
+    std::visit(
+        [&](const auto& j) {
+          k[1] = static_cast<double>(j.a);
+          k[2] = static_cast<double>(j.b);
+          put(3, j.anchor_a);
+          put(6, j.anchor_b);
+          k[9] = static_cast<double>(j.level);
+          if constexpr (std::is_same_v<std::decay_t<decltype(j)>, CoaxialConstraint>) {
+            put(10, j.axis_a);
+            put(13, j.axis_b);
+            k[16] = j.length;
+          }
+        },
+        c);
+    return k;
+  };
+  std::vector<char> duplicate(constraints.size(), 0);
+  if (constraints.size() < 2) return duplicate;
+  // Hashed: a thousand identical keys cost a thousand hashes and comparisons, not a sort's worth.
+  struct Hash {
+    std::size_t operator()(const Key& k) const {
+      std::uint64_t h = 0xcbf29ce484222325ull;  // FNV-1a over the values' bits
+      for (const double v : k) h = (h ^ std::bit_cast<std::uint64_t>(v == 0.0 ? 0.0 : v)) * 0x100000001b3ull;
+      return static_cast<std::size_t>(h);
+    }
+  };
+  std::unordered_set<Key, Hash> seen;
+  seen.reserve(constraints.size());
+  for (std::size_t i = 0; i < constraints.size(); ++i)
+    if (!seen.insert(key(constraints[i])).second) duplicate[i] = 1;  // an earlier copy is in
+  return duplicate;
 }
 
 }  // namespace impetus::ledas

@@ -6,6 +6,8 @@
 #include "solver_internal.hpp"
 
 #include <algorithm>
+#include <cmath>
+#include <limits>
 
 namespace impetus::ledas {
 
@@ -13,6 +15,22 @@ IslandSolver::IslandSolver(SolverSettings settings)
     : settings_(settings), equalities_(std::make_unique<EqualitySolver>(settings_)),
       complementarity_(std::make_unique<ComplementaritySolver>(settings_, *equalities_)) {}
 IslandSolver::~IslandSolver() = default;
+
+namespace {
+// Active-set solves allowed per row of a complementarity problem (work_budget), and the floor for
+// small problems.
+constexpr std::uint64_t kSolvesPerRow = 100;
+constexpr std::uint64_t kMinSolves = 100;
+// Rows whose A_kk differ by more than this factor (a 10¹²:1 mass ratio) are scaled before the solve.
+constexpr double kScaleSpread = 1e8;
+// A complementarity answer whose velocity changes exceed the asked ones by this factor is refused.
+constexpr double kAbsurdGain = 1e6;
+}  // namespace
+
+std::uint64_t work_budget(std::size_t rows, const SolverSettings& settings) {
+  const std::uint64_t size_bound = kMinSolves + kSolvesPerRow * static_cast<std::uint64_t>(rows);
+  return std::min(settings.max_iterations, size_bound);
+}
 
 SparseMatrix principal_submatrix(const SparseMatrix& a, std::span<const RowIndex> subset) {
   std::vector<int> position(static_cast<std::size_t>(a.rows()), -1);
@@ -41,8 +59,41 @@ void IslandSolver::solve_subset(const SparseMatrix& a, const Vector& c, std::spa
   equalities_->solve_subset(a, c, subset, p, stats);
 }
 
+// A 10¹²:1 mass ratio puts rows of A_kk ~ 1e-12 next to rows of A_kk ~ 1: below the rank tolerance
+// (relative to max A_kk) the light rows' partners look like "nothing movable", and the active set cycles
+// on rounding. The problem is invariant under the diagonal scaling p = S p̂, S = diag(A_kk)^-½ (p ≥ 0
+// ⇔ p̂ ≥ 0, ŵ = S w): solved as Â = S A S, ĉ = S c, whose diagonal is 1 wherever a body can move. The
+// tolerance becomes tolerance · min S (so w ≥ −tolerance still holds on every row). Only for spreads
+// beyond kScaleSpread: ordinary problems are solved exactly as before, bit for bit.
 Vector IslandSolver::solve_complementarity(const ComplementarityProblem& problem, SolverStats& stats) {
-  return complementarity_->solve(problem, stats);
+  Vector p = solve_balanced(problem, stats);
+  // An answer whose velocity changes A p dwarf every change the problem asks for (‖c‖) is rounding
+  // blown up along a null direction of conflicting targets (a body pinned by a joint deep inside the
+  // ground: the joint's and the contact's rows are parallel), not physics: refused, nothing applied.
+  const double asked = problem.rhs.lpNorm<Eigen::Infinity>() + problem.tolerance;
+  if (p.size() > 0 && !((*problem.matrix * p).lpNorm<Eigen::Infinity>() <= kAbsurdGain * asked)) {
+    ++stats.refused;
+    ++stats.non_converged;
+    p.setZero();
+  }
+  return p;
+}
+
+Vector IslandSolver::solve_balanced(const ComplementarityProblem& problem, SolverStats& stats) {
+  const SparseMatrix& a = *problem.matrix;
+  double hi = 0.0, lo = std::numeric_limits<double>::infinity();
+  for (Eigen::Index k = 0; k < a.rows(); ++k)
+    if (const double d = a.coeff(k, k); d > 0.0 && std::isfinite(d)) hi = std::max(hi, d), lo = std::min(lo, d);
+  if (!(hi > kScaleSpread * lo)) return complementarity_->solve(problem, stats);
+  Vector scale = Vector::Ones(a.rows());
+  for (Eigen::Index k = 0; k < a.rows(); ++k)
+    if (const double d = a.coeff(k, k); d > 0.0 && std::isfinite(d)) scale(k) = 1.0 / std::sqrt(d);
+  const SparseMatrix scaled = scale.asDiagonal() * a * scale.asDiagonal();
+  ComplementarityProblem balanced = problem;
+  balanced.matrix = &scaled;
+  balanced.rhs = scale.cwiseProduct(problem.rhs);
+  balanced.tolerance = problem.tolerance / std::sqrt(hi);
+  return scale.cwiseProduct(complementarity_->solve(balanced, stats));
 }
 
 }  // namespace impetus::ledas

@@ -75,6 +75,9 @@ void LedasResolver::resolve(std::span<RigidBody> bodies, std::span<Contact> cont
   counters.singular_systems += failed;
   counters.redundant_systems += rank_deficient - failed;
   counters.nan_caught += stats_.velocity.nan_caught + stats_.position.nan_caught + stats_.friction.nan_caught;
+  counters.work_limited += stats_.velocity.work_limited + stats_.position.work_limited;
+  counters.corrections_clamped += stats_.corrections_clamped;
+  counters.largest_correction = std::max(counters.largest_correction, stats_.largest_correction);
 }
 
 void LedasResolver::bodies_removed(std::span<const std::int64_t> new_index) noexcept {
@@ -148,7 +151,17 @@ void LedasResolver::build_rows(std::span<const RigidBody> bodies, std::span<Cont
       }
     }
   }
-  for (const Constraint& c : constraints) ledas::append_constraint_rows(bodies, inertia_, c, dt, rows_, info_);
+  // The same joint given twice (or a thousand times) repeats its rows exactly: the velocities are those
+  // of one copy (the minimum-norm split shares the impulse equally and moves nothing more), so only the
+  // first copy enters the system, instead of a singular island solved at dense cubic cost.
+  const std::vector<char> duplicate = ledas::duplicate_constraints(constraints);
+  for (std::size_t i = 0; i < constraints.size(); ++i) {
+    if (duplicate[i]) {
+      ++stats_.duplicate_constraints;
+      continue;
+    }
+    ledas::append_constraint_rows(bodies, inertia_, constraints[i], dt, rows_, info_);
+  }
   row_warm_.resize(rows_.size(), 0.0);
 }
 

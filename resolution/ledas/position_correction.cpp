@@ -4,6 +4,9 @@
 #include "island.hpp"
 #include "impetus/resolution/ledas/ledas.hpp"
 
+#include <algorithm>
+#include <cmath>
+#include <span>
 #include <vector>
 
 namespace impetus {
@@ -34,22 +37,51 @@ void LedasResolver::correct_positions(ledas::Island& island, std::span<RigidBody
   problem.rhs = ledas::Vector::Zero(static_cast<Eigen::Index>(m));
   problem.tolerance = kPositionTolerance;
   bool needed = false;
+  double total_target = 0.0;  // Σ targets: the displacement bound's scale (resting.hpp)
   for (std::size_t j = 0; j < m; ++j) {
     const std::size_t i = local(j);
     problem.equality[j] = island.equality[i];
     if (island.equality[i]) continue;
     const double t = resolution::correction_target(info_[island.rows[i]].depth, settings_.resting);
     problem.rhs(static_cast<Eigen::Index>(j)) = t;
+    total_target += t;
     // q = 0 already meets a target within the problem's tolerance (w = −t ≥ −tolerance): a contact
     // overlapping by the slop plus rounding (a generated pyramid at rest) asks for no solve.
     problem.start[j] = t > kPositionTolerance;
     needed = needed || t > kPositionTolerance;
   }
   if (!needed) return;
-  const ledas::Vector q = solver_.solve_complementarity(problem, stats_.position);
+  const std::uint64_t refused_before = stats_.position.refused;
+  ledas::Vector q = solver_.solve_complementarity(problem, stats_.position);
+  // No correction moves a body absurdly far (conflicting targets: a body pinned deep in the ground).
+  std::vector<const resolution::ImpulseRow*> rows(m);
+  for (std::size_t j = 0; j < m; ++j) rows[j] = &rows_[island.rows[local(j)]];
+  const resolution::CorrectionBound bound = resolution::bound_correction(
+      rows, std::span<double>(q.data(), m), resolution::kCorrectionBoundFactor * total_target, bodies);
+  bool clamped = bound.scale < 1.0 || stats_.position.refused > refused_before;  // refused: clamped to 0
+  // Nor may it open a joint: the joint rows hold with target 0, so a consistent correction leaves them
+  // shut to rounding; conflicting targets (a body pinned deep in the ground) would drag the joint apart
+  // and hand the next velocity phase an impossible target. The correction is scaled down until no joint
+  // row opens by more than the slop.
+  double opening = 0.0;
+  if (std::find(problem.equality.begin(), problem.equality.end(), 1) != problem.equality.end()) {
+    const ledas::Vector separation = *problem.matrix * q;
+    for (std::size_t j = 0; j < m; ++j)
+      if (problem.equality[j]) opening = std::max(opening, std::abs(separation(static_cast<Eigen::Index>(j))));
+  }
+  const double allowed = std::max(settings_.resting.slop, kPositionTolerance);
+  double largest = bound.largest;
+  if (opening > allowed) {
+    const double scale = allowed / opening;
+    q *= scale;
+    largest *= scale;
+    clamped = true;
+  }
+  if (clamped) ++stats_.corrections_clamped;
+  stats_.largest_correction = std::max(stats_.largest_correction, largest);
   for (std::size_t j = 0; j < m; ++j)
     if (const double qj = q(static_cast<Eigen::Index>(j)); qj != 0.0)
-      resolution::apply_row_displacement(rows_[island.rows[local(j)]], qj, bodies);
+      resolution::apply_row_displacement(*rows[j], qj, bodies);
 }
 
 }  // namespace impetus

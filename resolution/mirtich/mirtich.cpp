@@ -166,12 +166,14 @@ std::uint64_t sweep_island(const std::vector<std::uint32_t>& island, Workspace& 
 // Position correction of one island (resting.hpp): projected Gauss–Seidel on pseudo-impulses q ≥ 0
 // with accumulated clamping for A q ≥ target, then one displacement per row. Velocities are untouched.
 void correct_island(const std::vector<std::uint32_t>& island, Workspace& ws, std::span<const Contact> contacts,
-                    std::span<RigidBody> bodies, const MirtichSettings& settings) {
+                    std::span<RigidBody> bodies, const MirtichSettings& settings, ResolverCounters& counters) {
   std::vector<double> target(island.size());
   bool any = false;
+  double total_target = 0.0;  // Σ targets: the displacement bound's scale (resting.hpp)
   for (std::size_t j = 0; j < island.size(); ++j) {
     target[j] = resolution::correction_target(contacts[island[j]].depth, settings.resting);
     any = any || target[j] > 0.0;
+    total_target += target[j];
   }
   if (!any) return;  // nothing penetrates beyond the slop: q = 0 is the solution
 
@@ -198,9 +200,16 @@ void correct_island(const std::vector<std::uint32_t>& island, Workspace& ws, std
     }
     if (largest_change < kPositionTolerance) break;
   }
+  // No correction moves a body absurdly far (the displacement bound, resting.hpp).
+  std::vector<const resolution::ImpulseRow*> rows(island.size());
+  for (std::size_t j = 0; j < island.size(); ++j) rows[j] = &ws.rows[island[j]];
+  const resolution::CorrectionBound bound =
+      resolution::bound_correction(rows, q, resolution::kCorrectionBoundFactor * total_target, bodies);
+  if (bound.scale < 1.0) ++counters.corrections_clamped;
+  counters.largest_correction = std::max(counters.largest_correction, bound.largest);
   // All displacements use the rows built before the correction: first order in the (small) motion.
   for (std::size_t j = 0; j < island.size(); ++j)
-    if (q[j] > 0.0) resolution::apply_row_displacement(ws.rows[island[j]], q[j], bodies);
+    if (q[j] > 0.0) resolution::apply_row_displacement(*rows[j], q[j], bodies);
 }
 
 // Writes each contact's impulses and final mode (before the position correction moves the bodies):
@@ -274,7 +283,7 @@ void MirtichResolver::resolve(std::span<RigidBody> bodies, std::span<Contact> co
     counters.residual = std::max(counters.residual, residual.max_approach);
     counters.complementarity_error = std::max(counters.complementarity_error, residual.complementarity);
     record_outcomes(ws, contacts, bodies, settings_.tolerance, counters);
-    for (const auto& island : islands) correct_island(island, ws, contacts, bodies, settings_);
+    for (const auto& island : islands) correct_island(island, ws, contacts, bodies, settings_, counters);
   } catch (...) {
     // Only allocation can throw here; report it as a failed (non-converged) resolution.
     ++counters.non_converged;

@@ -26,6 +26,31 @@ bool state_is_finite(const RigidBody& b) {
          all_finite(b.angular_velocity);
 }
 
+// What the run reports of a state must be finite too: a finite velocity of 1e200 m/s has an infinite
+// kinetic energy. Adds a movable body's kinetic energy, momenta and load potential to the running sums
+// and returns the name of the first of them (the body's own or the sum) that is not finite, else null.
+struct MeasureSums {
+  double kinetic = 0.0, potential = 0.0;
+  Vec3 linear = Vec3::Zero(), angular = Vec3::Zero();
+};
+const char* measure_overflow(const RigidBody& b, const Vec3& gravity, MeasureSums& sums) {
+  if (b.fixed) return nullptr;
+  const Vec3 spin = b.rotation.transpose() * b.angular_velocity;  // ω in the body frame
+  const double kinetic = 0.5 * b.mass * b.velocity.squaredNorm() + 0.5 * spin.dot(b.inertia_body * spin);
+  const Vec3 linear = b.mass * b.velocity;
+  const Vec3 angular = b.position.cross(linear) + b.rotation * (b.inertia_body * spin);
+  const double potential = -(b.mass * gravity + b.force).dot(b.position);
+  sums.kinetic += kinetic;
+  sums.potential += potential;
+  sums.linear += linear;
+  sums.angular += angular;
+  if (!std::isfinite(kinetic) || !std::isfinite(sums.kinetic)) return "kinetic energy";
+  if (!all_finite(linear) || !all_finite(sums.linear)) return "linear momentum";
+  if (!all_finite(angular) || !all_finite(sums.angular)) return "angular momentum";
+  if (!std::isfinite(potential) || !std::isfinite(sums.potential)) return "potential energy";
+  return nullptr;
+}
+
 std::string body_label(const RigidBody& body, std::size_t index) {
   return "body '" + (body.name.empty() ? "#" + std::to_string(index) : body.name) + "'";
 }
@@ -74,13 +99,9 @@ void validate_body(const RigidBody& body, std::size_t index) {
   if (!all_finite(body.inertia_body) || !(eig.eigenvalues().minCoeff() > 0.0) ||
       !((body.inertia_body * body.inv_inertia_body - Mat3::Identity()).norm() < 1e-6))
     throw Error(label + ": inertia must be symmetric positive definite with a matching inverse");
-  // Finite values whose products are not: the energies and momenta every step measures.
-  const Vec3 momentum = body.mass * body.velocity;
-  const Vec3 spin = body.rotation * body.inertia_body * body.rotation.transpose() * body.angular_velocity;
-  if (!std::isfinite(momentum.dot(body.velocity)) || !std::isfinite(spin.dot(body.angular_velocity)) ||
-      !all_finite(body.position.cross(momentum)) || !std::isfinite(body.mass * body.position.norm()))
-    throw Error(label + ": mass " + format_number(body.mass) + ", position, velocity and angular velocity overflow "
-                "its kinetic energy or momentum (m |v|², ω·Iω, x × m v and m |x| must be finite)");
+  MeasureSums own;  // this body alone: a finite state whose energy or momentum overflows is refused
+  if (const char* what = measure_overflow(body, Vec3::Zero(), own))
+    throw Error(label + ": its " + what + " is not finite (velocities, mass or inertia too large to measure)");
 }
 
 // The bodies a constraint joins and whether they still collide, whatever its kind.
@@ -292,6 +313,10 @@ void World::detect(StepStatus& status) {
   if (detector_) {
     sync_detector();
     detector_->detect(bodies_, context(), contacts_, status.detector);
+    if (refused_detection(status)) {
+      status.profile.detect = seconds_since(start);
+      return;
+    }
     if (settings_.sleep.enabled) {
       // Touching a sleeping group wakes it; its own contacts were skipped while it slept, so detect again
       // (until no more groups wake: a woken group may touch another).
@@ -299,6 +324,10 @@ void World::detect(StepStatus& status) {
       while (wake_touched(status)) {
         contacts_.clear();
         detector_->detect(bodies_, context(), contacts_, status.detector);
+        if (refused_detection(status)) {
+          status.profile.detect = seconds_since(start);
+          return;
+        }
       }
       if (stepping_ && !woken_now_.empty()) kick_woken(status);
       // Whatever detector is in use, contacts between quiet bodies (asleep, or fixed at rest) go nowhere.
@@ -309,6 +338,22 @@ void World::detect(StepStatus& status) {
     }
   }
   status.profile.detect = seconds_since(start);
+}
+
+// A detector that refused the detection (more candidate pairs than its limit: many bodies at one point)
+// fails the step, naming the most crowded body; nothing is resolved and the state is not changed by it.
+bool World::refused_detection(StepStatus& status) {
+  const DetectorCounters& d = status.detector;
+  if (d.pair_limit == 0) return false;
+  contacts_.clear();
+  status.ok = false;
+  const auto body = static_cast<std::size_t>(d.crowded_body);
+  const std::string who = body < bodies_.size() ? body_label(bodies_[body], body) : "body #" + std::to_string(body);
+  status.message = "detector: " + std::to_string(d.pair_limit) + " candidate pairs and more at step " +
+                   std::to_string(step_count_) + " (its pair limit; " + who + " overlaps at least " +
+                   std::to_string(d.crowded_pairs) +
+                   " others): detection refused, state restored to before the step";
+  return true;
 }
 
 void World::resolve(StepStatus& status) {
@@ -335,12 +380,28 @@ bool World::check_finite(StepStatus& status, const char* stage) {
       if (first_bad == bodies_.size()) first_bad = i;
     }
   }
-  if (first_bad == bodies_.size()) return true;
-  status.ok = false;
-  status.message = body_label(bodies_[first_bad], first_bad) + " became non-finite during " + stage +
-                   " at step " + std::to_string(step_count_) + "; state restored to before the step";
-  restore_snapshot();
-  return false;
+  if (first_bad < bodies_.size()) {
+    status.ok = false;
+    status.message = body_label(bodies_[first_bad], first_bad) + " became non-finite during " + stage +
+                     " at step " + std::to_string(step_count_) + "; state restored to before the step";
+    restore_snapshot();
+    return false;
+  }
+  // A finite but absurd state (1e200 m/s, dt = 1e300 s) whose energy or momentum overflows is stopped
+  // the same way: the run's summary would otherwise report inf or nan.
+  MeasureSums sums;
+  for (std::size_t i = 0; i < bodies_.size(); ++i) {
+    if (const char* what = measure_overflow(bodies_[i], settings_.gravity, sums)) {
+      ++status.nan_caught;
+      status.ok = false;
+      status.message = body_label(bodies_[i], i) + ": its " + what + " (or the world's total) overflowed during " +
+                       stage + " at step " + std::to_string(step_count_) +
+                       " (a finite state too large to measure); state restored to before the step";
+      restore_snapshot();
+      return false;
+    }
+  }
+  return true;
 }
 
 // Only the state is saved (not names or shapes): this runs every step.
@@ -405,8 +466,12 @@ const StepStatus& World::step() {
       hold_sleepers();
     });
     ok = check_finite(status_, "velocity integration");
-    // 2. detect contacts at the current positions
-    if (ok) detect(status_);
+    // 2. detect contacts at the current positions (a refused detection fails the step)
+    if (ok) {
+      detect(status_);
+      ok = status_.ok;
+      if (!ok) restore_snapshot();
+    }
     // 3. resolve: impulses make the predicted velocities admissible
     if (ok) {
       resolve(status_);
@@ -431,7 +496,11 @@ const StepStatus& World::step() {
       move_prescribed();
     });
     ok = check_finite(status_, "integration");
-    if (ok) detect(status_);
+    if (ok) {
+      detect(status_);
+      ok = status_.ok;
+      if (!ok) restore_snapshot();
+    }
     if (ok) {
       resolve(status_);
       ok = check_finite(status_, "resolution");

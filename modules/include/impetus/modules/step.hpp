@@ -29,6 +29,12 @@ struct DetectorCounters {
   std::uint64_t narrowphase_calls = 0; ///< exact shape-pair tests
   std::uint64_t contacts = 0;          ///< contacts produced
   std::uint64_t contacts_dropped = 0;  ///< contacts rejected (NaN or zero normal, duplicates, manifold reduction)
+  /// Non-zero when the broadphase found more candidate pairs than the detector's pair limit allows (a
+  /// pathological scene: many bodies generated at one point): the limit, and the detection is refused
+  /// (no contacts; the world fails the step, naming `crowded_body`). Never an allocation of every pair.
+  std::uint64_t pair_limit = 0;
+  std::uint64_t crowded_body = 0;   ///< with pair_limit: the body in the most candidate pairs found
+  std::uint64_t crowded_pairs = 0;  ///< with pair_limit: how many candidate pairs it was in when it stopped
 };
 
 /// Resolver counters for one step.
@@ -55,6 +61,14 @@ struct ResolverCounters {
   /// this step (fclib's measure without its scaling; 0 when no contact has friction).
   double natural_map_residual = 0.0;
   double friction_work = 0.0;          ///< work of the tangential impulses (J, ≤ 0: friction dissipates)
+  /// Problems stopped by the resolver's work budget before they converged (also in non_converged): the
+  /// best iterate is applied and the step goes on, bounded in time.
+  std::uint64_t work_limited = 0;
+  /// Position corrections scaled down because they would have moved a body further than the bound
+  /// (resolution/common/resting.hpp, "Displacement bound"): conflicting targets, e.g. a body pinned by a
+  /// joint deep inside the ground.
+  std::uint64_t corrections_clamped = 0;
+  double largest_correction = 0.0;     ///< largest displacement a position correction gave a body (m)
 };
 
 }  // namespace impetus

@@ -29,7 +29,9 @@ class ModuleOptions;
 /// singular_systems, which now counts only real failures).
 /// 6: applied loads in the body frame and prescribed motion of fixed bodies (RigidBody::force_body,
 /// torque_body, motion); CollisionResolver::bodies_removed. 7: RigidBody::asleep (sleeping islands).
-inline constexpr std::uint32_t kPluginAbiVersion = 7;
+/// 8: pathological scenes (DetectorCounters::pair_limit, crowded_body, crowded_pairs;
+/// ResolverCounters::work_limited, corrections_clamped, largest_correction).
+inline constexpr std::uint32_t kPluginAbiVersion = 8;
 
 /// Name of the entry symbol every plugin exports.
 inline constexpr const char* kPluginEntrySymbol = "impetus_plugin_descriptor";

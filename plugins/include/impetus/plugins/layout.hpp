@@ -97,13 +97,14 @@ inline LayoutWords plugin_layout_words() {
       layout_word<IntegratorCounters>(&IntegratorCounters::bodies, &IntegratorCounters::orthonormalized);
   using DC = DetectorCounters;
   at(LayoutType::detector_counters) =
-      layout_word<DC>(&DC::pairs_tested, &DC::narrowphase_calls, &DC::contacts, &DC::contacts_dropped);
+      layout_word<DC>(&DC::pairs_tested, &DC::narrowphase_calls, &DC::contacts, &DC::contacts_dropped,
+                              &DC::pair_limit, &DC::crowded_body, &DC::crowded_pairs);
   using RC = ResolverCounters;
   at(LayoutType::resolver_counters) =
       layout_word<RC>(&RC::islands, &RC::contacts, &RC::rounds, &RC::pulling_impulses, &RC::non_converged,
                       &RC::singular_systems, &RC::redundant_systems, &RC::nan_caught, &RC::residual, &RC::complementarity_error,
                       &RC::energy_gain_events, &RC::sticking, &RC::sliding, &RC::natural_map_residual,
-                      &RC::friction_work);
+                      &RC::friction_work, &RC::work_limited, &RC::corrections_clamped, &RC::largest_correction);
   at(LayoutType::module_status) = layout_word<ModuleStatus>(&ModuleStatus::ok, &ModuleStatus::message);
   at(LayoutType::module_options) = layout_word<ModuleOptions>();  // private fields: size and alignment
   at(LayoutType::option_value) = layout_word<OptionValue>(&OptionValue::text, &OptionValue::items,

@@ -76,8 +76,12 @@ struct StepStatus {
   std::uint64_t awake_bodies = 0;     ///< movable bodies awake at the end of the step
   std::uint64_t sleeping_bodies = 0;  ///< movable bodies asleep at the end of the step
   std::uint64_t woken_bodies = 0;     ///< bodies woken during the step
-  std::uint64_t nan_caught = 0;  ///< bodies whose state became non-finite (restored to before the step)
-  bool ok = true;                ///< false when anything non-finite was caught
+  /// Bodies whose state became non-finite, or whose kinetic energy or momenta overflowed (restored to
+  /// before the step).
+  std::uint64_t nan_caught = 0;
+  /// False when anything non-finite was caught, or the detector refused the detection (more candidate
+  /// pairs than its limit, DetectorCounters::pair_limit): the state is restored to before the step.
+  bool ok = true;
   std::string message;           ///< why not ok, naming the body and the stage
 };
 
@@ -164,6 +168,7 @@ class World {
   void resolve(StepStatus& status);
   void sync_detector();
   bool check_finite(StepStatus& status, const char* stage);
+  bool refused_detection(StepStatus& status);
   void take_snapshot();
   void restore_snapshot();
   void move_prescribed();

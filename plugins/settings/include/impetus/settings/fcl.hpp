@@ -5,6 +5,8 @@
 
 #include "impetus/settings/options_writer.hpp"
 
+#include <cstddef>
+
 namespace impetus {
 
 /// Settings of the `fcl` detector (scene options of the same names).
@@ -21,14 +23,23 @@ struct FclDetectorSettings {
   /// Points of one pair closer than this × the smaller body's bounding radius are merged into the
   /// deeper one (relative, 0 … 0.5).
   double merge_tolerance = 1e-3;
+  /// Most broadphase candidate pairs per movable body (the limit is this × movable bodies, at least
+  /// kMinPairLimit); beyond it the detection is refused (DetectorCounters::pair_limit) instead of
+  /// allocating every pair: many bodies at one point. Touching equal spheres have at most 12 neighbours
+  /// each (6 pairs per body); 0: no limit.
+  int max_pairs_per_body = 16;
+  /// The smallest pair limit, whatever the number of bodies.
+  static constexpr std::size_t kMinPairLimit = 1024;
 
-  /// Reads `margin`, `max_contacts_per_pair` and `merge_tolerance`; throws OptionError on a bad value.
+  /// Reads `margin`, `max_contacts_per_pair`, `merge_tolerance` and `max_pairs_per_body`; throws OptionError on a bad value.
   static FclDetectorSettings from_options(const ModuleOptions& options) {
     FclDetectorSettings s;
     s.margin = options.number("margin", s.margin, 0.0, 1e3);
     s.max_contacts_per_pair =
         static_cast<int>(options.integer("max_contacts_per_pair", s.max_contacts_per_pair, 0, 4));
     s.merge_tolerance = options.number("merge_tolerance", s.merge_tolerance, 0.0, 0.5);
+    s.max_pairs_per_body =
+        static_cast<int>(options.integer("max_pairs_per_body", s.max_pairs_per_body, 0, 1'000'000));
     return s;
   }
 
@@ -41,6 +52,8 @@ struct FclDetectorSettings {
     put(o, "max_contacts_per_pair", static_cast<long long>(max_contacts_per_pair),
         static_cast<long long>(d.max_contacts_per_pair));
     put(o, "merge_tolerance", merge_tolerance, d.merge_tolerance);
+    put(o, "max_pairs_per_body", static_cast<long long>(max_pairs_per_body),
+        static_cast<long long>(d.max_pairs_per_body));
     return o;
   }
 };

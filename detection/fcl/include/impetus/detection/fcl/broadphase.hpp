@@ -33,8 +33,9 @@ class Broadphase {
   /// are a superset of those whose boxes overlap; the caller checks the exact boxes.
   void move(BodyIndex index, const Aabb& box, double slack);
   /// Appends every pair whose boxes overlap, lower index first: movable–movable and movable–fixed.
-  /// The order is FCL's traversal order (the caller sorts).
-  void collect(std::vector<BodyPair>& pairs);
+  /// The order is FCL's traversal order (the caller sorts). Stops once `pairs` holds `limit` entries and
+  /// returns false (the pairs are then a partial list); true when every pair was appended.
+  bool collect(std::vector<BodyPair>& pairs, std::size_t limit);
 
  private:
   struct Impl;

@@ -13,6 +13,14 @@
 /// separation, to first order in the displacement). The displacement moves positions and rotations
 /// directly (apply_row_displacement) and never touches velocities.
 ///
+/// **Displacement bound.** With conflicting targets (a body pinned by a joint deep inside the ground:
+/// the joint holds, the contact pushes) the correction problem has no solution and the best q can be
+/// arbitrarily large. No correction may move a point of a body, at the rows' points, further than
+///   L = kCorrectionBoundFactor · Σ_k target_k   (twice the total separation the island asks for)
+/// nor turn a body by more than kMaxCorrectionTurn; a larger correction is scaled down as a whole (q ← s q,
+/// the same direction) and counted in ResolverCounters::corrections_clamped. A consistent correction
+/// moves each point by at most the separations along its path to the support, so it never reaches L.
+///
 /// A bounce threshold stops jitter: an island whose fastest approach is slower than `bounce_threshold`
 /// gets e = 0. It is judged per island, not per contact, because in a simultaneous impact touching
 /// contacts (v_n = 0) carry the restitution phase too (Newton's cradle: (1 + e) p on every contact).
@@ -35,6 +43,24 @@ inline double effective_restitution(const ImpulseRow& row, double impact_speed, 
 inline double correction_target(double depth, const RestingSettings& settings) {
   return settings.correction * std::max(0.0, depth - settings.slop);
 }
+
+/// L = kCorrectionBoundFactor · Σ targets (m); see "Displacement bound" above.
+inline constexpr double kCorrectionBoundFactor = 2.0;
+/// Largest turn a position correction may give a body in one step (rad).
+inline constexpr double kMaxCorrectionTurn = 0.5;
+
+/// What bound_correction found: the factor applied to q (1: untouched) and the largest displacement of
+/// a row point after it (m).
+struct CorrectionBound {
+  double scale = 1.0;
+  double largest = 0.0;
+};
+
+/// The displacement bound of one island's correction: `rows[j]` receives the pseudo-impulse `q[j]`
+/// (kg·m), `limit` is L (m). Scales every q[j] by s < 1 when the displacement (translation plus turn at
+/// the rows' points, to first order) or a turn would exceed the bound; leaves q bit for bit otherwise.
+CorrectionBound bound_correction(std::span<const ImpulseRow* const> rows, std::span<double> q, double limit,
+                                 std::span<const RigidBody> bodies);
 
 /// Moves the row's bodies apart by pseudo-impulse `q` (kg·m): Δx = σ q n / M, and R turned by
 /// σ q J⁻¹ (r × n) (Rodrigues). Velocities are unchanged. Fixed bodies do not move.

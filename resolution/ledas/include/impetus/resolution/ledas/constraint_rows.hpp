@@ -64,4 +64,9 @@ double constraint_gap(std::span<const RigidBody> bodies, const Constraint& const
 /// non-positive length, a non-finite anchor.
 std::string constraint_problem(const Constraint& constraint);
 
+/// Per constraint: whether it is identical to an earlier one (same kind, bodies, anchors, axes, length
+/// and level; `collide` aside), so its rows would repeat the earlier one's row for row. Hashed keys:
+/// O(n) in the number of constraints.
+std::vector<char> duplicate_constraints(std::span<const Constraint> constraints);
+
 }  // namespace impetus::ledas

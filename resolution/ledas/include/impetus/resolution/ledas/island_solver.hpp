@@ -65,7 +65,13 @@ struct SolverStats {
   std::uint64_t iterations = 0;   ///< active-set iterations (one linear solve each)
   std::uint64_t released = 0;     ///< rows released because their impulse came out negative (pulling)
   std::uint64_t added = 0;        ///< rows added because they would have approached
-  std::uint64_t non_converged = 0;  ///< complementarity problems that hit max_iterations
+  std::uint64_t non_converged = 0;  ///< complementarity problems that hit max_iterations or the work budget
+  /// Of non_converged, the problems stopped by the work budget (work_budget(): linear solves bounded by
+  /// the problem's size, whatever max_iterations allows): the best iterate is returned.
+  std::uint64_t work_limited = 0;
+  /// Of non_converged, the answers refused (zero returned) because their velocity changes A p exceeded
+  /// 10⁶ × (‖c‖ + tolerance): rounding blown up along a null direction of conflicting targets.
+  std::uint64_t refused = 0;
   /// Problems with no solution (conflicting targets, e.g. a position correction squeezing a body
   /// between fixed bodies): solved as far as the ratio test allows, counted here, not in non_converged.
   std::uint64_t infeasible = 0;
@@ -121,10 +127,19 @@ class IslandSolver {
   const SolverSettings& settings() const { return settings_; }
 
  private:
+  // solve_complementarity without the final check: diagonally scaled where A_kk spans too much.
+  Vector solve_balanced(const ComplementarityProblem& problem, SolverStats& stats);
   SolverSettings settings_;
   std::unique_ptr<EqualitySolver> equalities_;               // solve_subset (equality_solver.cpp)
   std::unique_ptr<ComplementaritySolver> complementarity_;  // solve_complementarity (complementarity.cpp)
 };
+
+/// The work budget of one complementarity problem of `rows` rows: at most this many active-set
+/// iterations (one linear solve each) in the search and as many in the minimum-norm fallback, and never
+/// more than `max_iterations`. A finite active-set method changes each row's state a few times; a problem
+/// still running after kSolvesPerRow solves per row is cycling on rounding (a 10¹²:1 mass ratio), and
+/// a million more solves would not finish it.
+std::uint64_t work_budget(std::size_t rows, const SolverSettings& settings);
 
 /// The principal submatrix A_SS of `a` for the rows `subset` (increasing).
 SparseMatrix principal_submatrix(const SparseMatrix& a, std::span<const RowIndex> subset);

@@ -44,6 +44,11 @@ struct LedasStats {
   /// Frictional islands whose restitution phase was scaled back so as not to raise the kinetic energy
   /// above its pre-impact value (resolution/ledas/README.md, "Restitution with friction").
   std::uint64_t restitution_capped = 0;
+  /// Position corrections scaled down to the displacement bound (resolution/common/resting.hpp).
+  std::uint64_t corrections_clamped = 0;
+  /// Constraints identical to an earlier one, left out of the system (their rows would repeat it).
+  std::uint64_t duplicate_constraints = 0;
+  double largest_correction = 0.0;  ///< largest displacement a position correction gave a row point (m)
 };
 
 /// The LEDAS resolver: contacts and assembly constraints (point-point, coaxial) in one system per island.
