@@ -120,6 +120,9 @@ void RunStats::add_step(const World& world, const StepStatus& status) {
   non_converged_ += status.resolver.non_converged;
   singular_ += status.resolver.singular_systems;
   redundant_ += status.resolver.redundant_systems;
+  work_limited_ += status.resolver.work_limited;
+  clamped_ += status.resolver.corrections_clamped;
+  largest_correction_ = std::max(largest_correction_, status.resolver.largest_correction);
   pulling_ += status.resolver.pulling_impulses;
   energy_gains_ += status.resolver.energy_gain_events;
   sticking_ += status.resolver.sticking;
@@ -242,7 +245,10 @@ json RunStats::summary(const World& world, double wall_seconds) const {
         {"pulling_impulses", pulling_},
         {"energy_gain_events", energy_gains_},
         {"max_residual_m_per_s", max_residual_},
-        {"max_natural_map_residual", max_natural_map_}}},
+        {"max_natural_map_residual", max_natural_map_},
+        {"work_limited", work_limited_},
+        {"corrections_clamped", clamped_},
+        {"largest_correction_m", largest_correction_}}},
       {"friction",
        {{"modelled", frictional_},
         {"sticking_contacts", sticking_}, {"sliding_contacts", sliding_},
@@ -329,6 +335,12 @@ void print_summary(const json& s, std::ostream& out) {
       << r["redundant_systems"].get<std::uint64_t>() << " redundant contact sets (minimum-norm), "
       << r["energy_gain_events"].get<std::uint64_t>() << " energy gains, max residual "
       << r["max_residual_m_per_s"].get<double>() << " m/s\n";
+  // Pathological scenes (README.md, "Reliability"): a solve stopped by its work budget, a position
+  // correction bounded. Shown only when it happened.
+  if (r["work_limited"].get<std::uint64_t>() > 0 || r["corrections_clamped"].get<std::uint64_t>() > 0)
+    out << "resolver limits       " << r["work_limited"].get<std::uint64_t>() << " solves stopped by the work budget, "
+        << r["corrections_clamped"].get<std::uint64_t>() << " position corrections clamped (largest "
+        << r["largest_correction_m"].get<double>() << " m)\n";
   // Without friction the stick/slide counts only say whether a contact's tangential velocity was zero.
   if (s["friction"].value("modelled", true))
     out << "friction              " << s["friction"]["sticking_contacts"].get<std::uint64_t>() << " sticking and "

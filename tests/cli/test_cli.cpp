@@ -451,6 +451,19 @@ TEST(CliSummary, WorkOfMovingFixedBodiesIsReportedNotFlagged) {
   EXPECT_NE(text.out.find("J work of moving fixed bodies"), std::string::npos) << text.out;
 }
 
+// A body pinned deep in the ground: the summary reports the bounded corrections ("resolver limits") and
+// the ball stays within the bound of where it was (0.4 m a step, README "Reliability"; it does not move
+// at all here, the correction being refused).
+TEST(CliSummary, BoundedCorrectionsAreReported) {
+  const std::string args = "run " + scene("pinned_in_ground.yaml") + " --steps 50";
+  const auto j = nlohmann::json::parse(run(args + " --json").out);
+  EXPECT_GT(j["resolver"]["corrections_clamped"].get<std::uint64_t>(), 0u) << j["resolver"].dump();
+  EXPECT_LE(j["resolver"]["largest_correction_m"].get<double>(), 0.4) << j["resolver"].dump();
+  EXPECT_LE(j["max_penetration_m"].get<double>(), 1.0 + 1e-9);
+  const Result text = run(args);
+  EXPECT_NE(text.out.find("position corrections clamped"), std::string::npos) << text.out;
+}
+
 // The friction line says "none" where no body has friction (drop.yaml): its stick/slide counts would
 // only tell which frictionless contacts had no tangential velocity. With friction (slope.yaml) it counts
 // sliding contacts and the energy friction dissipated (> 0 for a box sliding 1 s).
