@@ -177,7 +177,7 @@ namespace {
 // The first body with friction a resolver that does not model it refuses, and the first constraint
 // `resolver` refuses, each located where the scene wrote it (the world would say only "body 'x'" or
 // "constraint #i").
-void check_constraints(const Scene& scene, CollisionResolver& resolver, const std::string& name) {
+void check_resolver_accepts(const Scene& scene, CollisionResolver& resolver, const std::string& name) {
   if (const ModuleStatus friction = resolver.accept_friction(); !friction)
     for (std::size_t i = 0; i < scene.bodies.size() && i < scene.body_where.size(); ++i)
       if (scene.bodies[i].material.friction > 0.0)
@@ -216,7 +216,7 @@ std::unique_ptr<World> build_world(const Scene& scene, PluginHost& host) {
     ModuleOptions options = scene.resolver.options;
     const PluginRequest request = plugin_request(scene.resolver, ModuleKind::resolver, "ledas", options);
     std::shared_ptr<CollisionResolver> resolver = host.create_resolver(request);
-    check_constraints(scene, *resolver, request.name);
+    check_resolver_accepts(scene, *resolver, request.name);
     try {
       world->set_resolver(std::move(resolver));
     } catch (const Error& e) {
