@@ -3,8 +3,9 @@
 // the initial state (the pyramid drop, the line push) is restored before each step, untimed, so the
 // rows measure one well-defined step rather than a scene that falls apart as the benchmark runs.
 //
-// Rows: step/<resolver>/<scene>. Counters: bodies, contacts, rounds, and the mean time per step of each
-// stage (velocities_ms, detect_ms, resolve_ms, positions_ms) plus resolve_share = resolve / total.
+// Rows: step/<resolver>/<scene>; …_speculative_off with the detector's look-ahead off. Counters: bodies,
+// contacts, rounds, speculative_pairs, and the mean time per step of each stage (velocities_ms,
+// detect_ms, resolve_ms, positions_ms) plus resolve_share = resolve / total.
 // The resolvers run with their defaults (position correction on, warm starts on), as in a simulation.
 // With friction ("…_mu0.7"): the pyramid at rest (spheres at zero velocity, μ = 0.7 everywhere, where an
 // equilibrium exists) and stacks of N unit boxes on the ground (μ = 0.5), each step the frictional
@@ -53,7 +54,8 @@ std::vector<RigidBody> make_stack(int n, double mu) {
 
 enum class Scene { pyramid, line, resting_pyramid, stack };
 
-void step(benchmark::State& state, const std::string& resolver_name, Scene scene, int n, double restitution) {
+void step(benchmark::State& state, const std::string& resolver_name, Scene scene, int n, double restitution,
+          bool speculative = true) {
   const std::vector<RigidBody> initial =
       scene == Scene::pyramid ? make_pyramid(PyramidParams{.rows = n, .restitution = restitution})
       : scene == Scene::line  ? make_line(LineParams{.count = n, .restitution = restitution})
@@ -63,7 +65,9 @@ void step(benchmark::State& state, const std::string& resolver_name, Scene scene
   World world(settings);
   for (const RigidBody& b : initial) world.add_body(b);
   world.set_integrator(std::make_shared<MomentumIntegrator>(ModuleOptions{}));
-  world.set_detector(std::make_shared<FclDetector>());
+  FclDetectorSettings detector;
+  detector.speculative = speculative;
+  world.set_detector(std::make_shared<FclDetector>(detector));
   world.set_resolver(bench::make_resolver(resolver_name, /*velocity_only=*/false));
 
   const auto [sum, last, cold_ms] = bench::time_steps(state, world, initial);
@@ -71,6 +75,7 @@ void step(benchmark::State& state, const std::string& resolver_name, Scene scene
   state.counters["bodies"] = static_cast<double>(initial.size() - 1);
   state.counters["contacts"] = static_cast<double>(last.detector.contacts);
   state.counters["rounds"] = static_cast<double>(last.resolver.rounds);
+  state.counters["speculative_pairs"] = static_cast<double>(last.detector.speculative_pairs);
   state.counters["residual"] = last.resolver.residual;
   state.counters["velocities_ms"] = benchmark::Counter(1e3 * sum.velocities, per_step);
   state.counters["detect_ms"] = benchmark::Counter(1e3 * sum.detect, per_step);
@@ -106,6 +111,20 @@ int register_all() {
       for (int n : {10, 40})
         benchmark::RegisterBenchmark(("step/" + resolver + "/stack_" + std::to_string(n) + "_mu0.5").c_str(),
                                      [resolver, n](benchmark::State& st) { step(st, resolver, Scene::stack, n, 0.0); })
+            ->Unit(benchmark::kMillisecond);
+    }
+    // Speculative contacts off: what the look-ahead costs where nothing is fast (compare with the rows
+    // above; detection/fcl/README.md, "Fast bodies").
+    if (resolver == "ledas") {
+      for (int k : {20, 100}) {
+        if (k * (k + 1) / 2 > max_bodies) continue;
+        benchmark::RegisterBenchmark(("step/ledas/pyramid_" + std::to_string(k) + "_speculative_off").c_str(),
+                                     [k](benchmark::State& st) { step(st, "ledas", Scene::pyramid, k, 0.0, false); })
+            ->Unit(benchmark::kMillisecond);
+      }
+      if (1000 <= max_bodies)
+        benchmark::RegisterBenchmark("step/ledas/line_1000_e0_speculative_off",
+                                     [](benchmark::State& st) { step(st, "ledas", Scene::line, 1000, 0.0, false); })
             ->Unit(benchmark::kMillisecond);
     }
     for (int n : {10, 100, 1000, 10000}) {

@@ -59,6 +59,47 @@ std::string size_problem(const ShapeGeometry& g) {
   }
 }
 
+/// The distance from the body's centre of mass to its nearest surface (m): how far the body can be
+/// overlapped before a contact's normal may point out the wrong side. Half the thinnest dimension of a
+/// primitive; the nearest face of a convex hull; 0 for a triangle mesh (its plates may be thin anywhere);
+/// infinite for a plane (a half-space has no far side).
+double inner_radius(const ShapeGeometry& g) {
+  switch (g.kind) {
+    case ShapeKind::sphere:
+    case ShapeKind::capsule: return g.radius;
+    case ShapeKind::cylinder: return std::min(g.radius, g.half_length);
+    case ShapeKind::box: return g.half_extents.minCoeff();
+    case ShapeKind::plane: return std::numeric_limits<double>::infinity();
+    case ShapeKind::triangles: return 0.0;
+    case ShapeKind::convex: {
+      double nearest = std::numeric_limits<double>::infinity();
+      for (std::size_t t = 0; t < g.mesh->triangles.size(); ++t)
+        nearest = std::min(nearest, g.mesh->triangle_normals[t].dot(g.mesh->vertices[g.mesh->triangles[t][0]]));
+      return std::max(0.0, nearest);
+    }
+  }
+  return 0.0;
+}
+
+/// How far a body's surface can move in one step (m): translation plus rotation about the centre of mass
+/// (|ω| times the bounding radius), an upper bound.
+double reach(const RigidBody& body, double size, double dt) {
+  return dt * (body.velocity.norm() + body.angular_velocity.norm() * size);
+}
+
+/// Conservative advancement's iteration budget per speculative pair: past it the pair keeps its
+/// speculative contacts (the safe side: a possible impact is never dropped).
+constexpr int kAdvanceIterations = 16;
+
+/// `body` (placed as `now`) moved on by `tau` seconds at its current velocities.
+Placed advanced(const Placed& now, const RigidBody& body, double tau) {
+  Placed out = now;
+  out.x += tau * body.velocity;
+  const double turn = body.angular_velocity.norm() * tau;
+  if (turn > 0.0) out.R = Eigen::AngleAxisd(turn, body.angular_velocity.normalized()).toRotationMatrix() * now.R;
+  return out;
+}
+
 }  // namespace
 
 struct FclDetector::Impl {
@@ -67,6 +108,7 @@ struct FclDetector::Impl {
     FclShapePtr fcl;  // null for planes
     bool fixed = false;
     std::uint32_t group = 0, mask = 0;
+    double inner = 0.0;  // inner_radius(geometry)
   };
 
   FclDetectorSettings settings;
@@ -75,9 +117,12 @@ struct FclDetector::Impl {
   std::vector<BodyIndex> movable, planes;
   std::vector<std::uint64_t> excluded;  // sorted pair keys
   std::vector<Aabb> boxes;              // tight world boxes grown by half the margin (at rest: once)
+  std::vector<double> reach;            // how far each body's surface can move this step (m; 0 if at rest)
+  double thinnest = 0.0;                // the smallest inner radius of any body (m)
   Broadphase broadphase;
   std::vector<BodyPair> pairs;
   std::vector<ManifoldPoint> points;
+  std::vector<ManifoldPoint> speculative_points;  // a speculative pair's contacts while it is advanced
   MeshContacts mesh;
   FclDetectorProfile profile;
   bool ready = false;
@@ -91,6 +136,8 @@ struct FclDetector::Impl {
   ModuleStatus add_body(const RigidBody& body, BodyIndex index, MeshCache& meshes);
   bool filtered(BodyIndex a, BodyIndex b) const;
   void narrow(const Placed& a, const Placed& b, const Body& ba, const Body& bb);
+  bool meets_within_step(const Placed& a, const Placed& b, const RigidBody& ra, const RigidBody& rb, BodyIndex ia,
+                         BodyIndex ib, double dt, double closing);
   std::uint64_t finish_pair(BodyIndex a, BodyIndex b, double scale, std::vector<Contact>& contacts);
 };
 
@@ -146,6 +193,7 @@ ModuleStatus FclDetector::Impl::add_body(const RigidBody& body, BodyIndex index,
     return fail(std::string("FCL rejected its geometry: ") + e.what());
   }
   if (!body.position.allFinite() || !body.rotation.allFinite()) return fail("its pose is not finite");
+  entry.inner = inner_radius(entry.geometry);
   bodies.push_back(std::move(entry));
   if (bodies.back().geometry.kind == ShapeKind::plane) {
     planes.push_back(index);  // planes never enter a tree: they are tested against the boxes directly
@@ -168,11 +216,14 @@ ModuleStatus FclDetector::set_bodies(std::span<const RigidBody> bodies, std::spa
   s.planes.clear();
   s.broadphase.clear();
   s.boxes.assign(bodies.size(), Aabb{Vec3::Zero(), Vec3::Zero()});
+  s.reach.assign(bodies.size(), 0.0);
   try {
     Impl::MeshCache meshes;  // bodies sharing one mesh share its derived data and FCL geometry
     for (std::size_t i = 0; i < bodies.size(); ++i)
       if (ModuleStatus status = s.add_body(bodies[i], static_cast<BodyIndex>(i), meshes); !status) return status;
     s.broadphase.finish();
+    s.thinnest = std::numeric_limits<double>::infinity();
+    for (const Impl::Body& b : s.bodies) s.thinnest = std::min(s.thinnest, b.inner);
     s.excluded.clear();
     for (const BodyPair& p : excluded)
       s.excluded.push_back(pair_key(std::min(p.first, p.second), std::max(p.first, p.second)));
@@ -184,7 +235,7 @@ ModuleStatus FclDetector::set_bodies(std::span<const RigidBody> bodies, std::spa
   return ModuleStatus::success();
 }
 
-void FclDetector::detect(std::span<const RigidBody> bodies, const StepContext& /*ctx*/, std::vector<Contact>& contacts,
+void FclDetector::detect(std::span<const RigidBody> bodies, const StepContext& ctx, std::vector<Contact>& contacts,
                          DetectorCounters& counters) noexcept {
   Impl& s = *impl_;
   contacts.clear();
@@ -194,8 +245,10 @@ void FclDetector::detect(std::span<const RigidBody> bodies, const StepContext& /
   const auto start = Clock::now();
 
   // 1. Broadphase: refresh the movable bodies' boxes (grown by half the margin each, so a gap up to the
-  // margin still overlaps), traverse the trees (fattened boxes: a superset), test the planes, keep the
-  // pairs whose exact boxes overlap and that pass the filters, sort.
+  // margin still overlaps; a fast body's box also by its reach over the step, so whatever it can meet is
+  // a candidate), traverse the trees (fattened boxes: a superset), test the planes, keep the pairs whose
+  // exact boxes overlap and that pass the filters, sort.
+  const bool speculative = s.settings.speculative && std::isfinite(ctx.dt) && ctx.dt > 0.0;
   s.pairs.clear();
   // A scene asleep to the last body (and no fixed body moving) has nothing to detect.
   if (std::all_of(s.movable.begin(), s.movable.end(), [&](BodyIndex i) { return quiet(bodies[i]); }) &&
@@ -203,11 +256,22 @@ void FclDetector::detect(std::span<const RigidBody> bodies, const StepContext& /
     s.profile.broadphase = seconds(start, Clock::now());
     return;
   }
+  // A box grows by the body's reach only where a pair with it could need the look-ahead below (its
+  // closing, at most the two reaches, beyond the margin and half the thinner inner radius: so the faster
+  // body's reach beyond half the margin and a quarter of that radius). A slower partner's own reach, below
+  // its threshold, is then missed at most: never enough to pass through anything.
   for (BodyIndex i : s.movable) {
+    s.reach[i] = 0.0;
     if (bodies[i].asleep) continue;  // it has not moved since it fell asleep
     const Placed body = s.placed(bodies[i], i);
     if (!body.x.allFinite() || !body.R.allFinite()) continue;  // the world rolls such a state back
-    s.boxes[i] = grown(world_aabb(body), 0.5 * margin);
+    double grow = 0.5 * margin;
+    if (speculative) {
+      s.reach[i] = reach(bodies[i], body.size(), ctx.dt);
+      if (s.reach[i] > 0.5 * margin && s.reach[i] > 0.25 * std::min(s.bodies[i].inner, s.thinnest))
+        grow += s.reach[i];
+    }
+    s.boxes[i] = grown(world_aabb(body), grow);
     s.broadphase.move(i, s.boxes[i], 0.05 * body.size());
   }
   // Candidate pairs are bounded by work: many bodies generated at one point would give n²/2 of them (and
@@ -233,6 +297,7 @@ void FclDetector::detect(std::span<const RigidBody> bodies, const StepContext& /
   }
   for (BodyIndex p : s.planes) {
     const WorldPlane plane = world_plane(s.placed(bodies[p], p));
+    if (speculative) s.reach[p] = ctx.dt * bodies[p].velocity.norm();  // a moving plane
     const bool plane_quiet = quiet(bodies[p]);
     for (BodyIndex i : s.movable) {
       if (plane_quiet && quiet(bodies[i])) continue;
@@ -251,13 +316,38 @@ void FclDetector::detect(std::span<const RigidBody> bodies, const StepContext& /
   std::sort(s.pairs.begin(), s.pairs.end());
   const auto broad_end = Clock::now();
 
-  // 2. Narrowphase: one manifold per pair, in pair order (so the list comes out sorted).
+  // 2. Narrowphase: one manifold per pair, in pair order (so the list comes out sorted). A pair that can
+  // close by more than the margin and more than half the thinner body's inner radius in one step (it
+  // could pass through, or so deep into the other that the normal flips) is searched with its margin
+  // grown by that closing distance: speculative contacts, with depth = −gap, which the resolvers let
+  // close exactly at the end of the step (detection/fcl/README.md, "Fast bodies").
   for (const auto& [a, b] : s.pairs) {
     ++counters.narrowphase_calls;
     const Placed pa = s.placed(bodies[a], a), pb = s.placed(bodies[b], b);
     if (!pa.x.allFinite() || !pa.R.allFinite() || !pb.x.allFinite() || !pb.R.allFinite()) continue;
     s.points.clear();
+    s.pair.margin = margin;
+    bool speculative_pair = false;
+    double closing = 0.0;  // how far the pair's surfaces can close within the step, at most (m)
+    // The two reaches bound the closing: most pairs are ruled out without the exact bound.
+    const double thinner = 0.5 * std::min(s.bodies[a].inner, s.bodies[b].inner);
+    if (speculative && s.reach[a] + s.reach[b] > margin && s.reach[a] + s.reach[b] > thinner) {
+      const RigidBody &ra = bodies[a], &rb = bodies[b];
+      closing =
+          ctx.dt * ((rb.velocity - ra.velocity).norm() + ra.angular_velocity.norm() * pa.size() +
+                    rb.angular_velocity.norm() * pb.size());
+      if (closing > margin && closing > thinner && std::isfinite(closing)) {
+        s.pair.margin = margin + closing;
+        speculative_pair = true;
+        ++counters.speculative_pairs;
+      }
+    }
     s.narrow(pa, pb, s.bodies[a], s.bodies[b]);
+    // Speculative contacts are kept only if the bodies really meet within the step: a ball flying past
+    // an edge has a closest point ahead of it, but never reaches it.
+    if (speculative_pair && !s.points.empty() &&
+        !s.meets_within_step(pa, pb, bodies[a], bodies[b], a, b, ctx.dt, closing))
+      s.points.clear();
     const double scale = pa.kind() == ShapeKind::plane   ? pb.size()
                          : pb.kind() == ShapeKind::plane ? pa.size()
                                                          : std::min(pa.size(), pb.size());
@@ -283,14 +373,14 @@ void FclDetector::Impl::narrow(const Placed& a, const Placed& b, const Body& ba,
     return sphere_box_contacts(a, b, pair, points);
   if (ka == ShapeKind::box && kb == ShapeKind::box) {
     const AxisResult axis = box_box_axis(a, b);
-    if (axis.overlap >= -settings.margin) convex_contacts(a, b, axis, pair, points);
+    if (axis.overlap >= -pair.margin) convex_contacts(a, b, axis, pair, points);
     return;
   }
   // Generic convex pair: FCL's signed distance gives the gap or the penetration with witness points;
   // its normal is then checked and sharpened against the shapes' own face normals.
   const SignedDistance sd = fcl_signed_distance(*ba.fcl, a, *bb.fcl, b);
   if (!sd.ok) ++profile.fcl_failures;
-  if (sd.ok && sd.distance > settings.margin) return;
+  if (sd.ok && sd.distance > pair.margin) return;
   const double eps = 1e-12 * (a.size() + b.size());
   Vec3 fcl_normal = Vec3::Zero();
   if (sd.ok && sd.distance > eps) fcl_normal = (sd.on_b - sd.on_a).normalized();
@@ -305,7 +395,52 @@ void FclDetector::Impl::narrow(const Placed& a, const Placed& b, const Body& ba,
   candidates.push_back(hint);  // last: a face normal wins a tie
   const AxisResult axis =
       least_overlap_axis(a, b, {candidates.begin(), candidates.end()}, 1e-12 * (a.size() + b.size()));
-  if (axis.valid && axis.overlap >= -settings.margin) convex_contacts(a, b, axis, pair, points);
+  if (axis.valid && axis.overlap >= -pair.margin) convex_contacts(a, b, axis, pair, points);
+}
+
+// Conservative advancement over the step (the classic time-of-impact bound, as FCL's continuous
+// collision and Mirtich's thesis use it): the bodies
+// move on at their current velocities by the largest time their gap allows — gap over a bound on how
+// fast it can close (the relative velocity along the closest normal, plus |ω| times each bounding radius)
+// — until the gap is within the margin (they meet: true), the step is over or nothing is left within the
+// remaining look-ahead (they do not: false). Leaves s.points as they were on entry (the contacts now).
+bool FclDetector::Impl::meets_within_step(const Placed& a, const Placed& b, const RigidBody& ra, const RigidBody& rb,
+                                          BodyIndex ia, BodyIndex ib, double dt, double closing) {
+  const double margin = settings.margin;
+  const auto deepest = [](const std::vector<ManifoldPoint>& p) {
+    return *std::max_element(p.begin(), p.end(),
+                             [](const ManifoldPoint& l, const ManifoldPoint& r) { return l.depth < r.depth; });
+  };
+  if (-deepest(points).depth <= margin) return true;  // touching already
+  speculative_points = points;
+  const double spin = ra.angular_velocity.norm() * a.size() + rb.angular_velocity.norm() * b.size();
+  const Vec3 dv = rb.velocity - ra.velocity;
+  // Between convex shapes in translation the gap is a convex function of time, so its slope along the
+  // closest normal bounds how fast it closes; a triangle mesh is many shapes, and another piece may be
+  // closing faster, so there the whole relative speed is the bound.
+  const bool convex = a.kind() != ShapeKind::triangles && b.kind() != ShapeKind::triangles;
+  bool meets = true;  // undecided within the budget: keep the contacts
+  double tau = 0.0;
+  for (int iteration = 0; iteration < kAdvanceIterations; ++iteration) {
+    if (points.empty()) {
+      meets = false;  // nothing within the look-ahead left for the rest of the step
+      break;
+    }
+    const ManifoldPoint closest = deepest(points);
+    const double gap = -closest.depth;
+    if (gap <= margin) break;
+    const double rate = (convex ? std::abs(dv.dot(closest.normal)) : dv.norm()) + spin;
+    tau += (gap - 0.5 * margin) / rate;
+    if (!(tau < dt)) {  // also a rate of 0: the gap cannot close
+      meets = false;
+      break;
+    }
+    points.clear();
+    pair.margin = margin + closing * (1.0 - tau / dt);
+    narrow(advanced(a, ra, tau), advanced(b, rb, tau), bodies[ia], bodies[ib]);
+  }
+  points.swap(speculative_points);
+  return meets;
 }
 
 std::uint64_t FclDetector::Impl::finish_pair(BodyIndex a, BodyIndex b, double scale, std::vector<Contact>& contacts) {

@@ -109,10 +109,10 @@ std::vector<std::vector<std::uint32_t>> find_islands(std::span<const ImpulseRow>
 }
 
 ContactResidual measure_residual(std::span<const ImpulseRow> rows, std::span<const double> impulses,
-                                 std::span<const RigidBody> bodies) {
+                                 std::span<const RigidBody> bodies, std::span<const double> targets) {
   ContactResidual out;
   for (std::size_t k = 0; k < rows.size(); ++k) {
-    const double vn = row_velocity(rows[k], bodies);
+    const double vn = row_velocity(rows[k], bodies) - (k < targets.size() ? targets[k] : 0.0);
     out.max_approach = std::max(out.max_approach, -vn);
     if (k < impulses.size()) out.complementarity = std::max(out.complementarity, std::abs(impulses[k] * vn));
   }

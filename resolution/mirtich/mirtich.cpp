@@ -21,7 +21,10 @@ constexpr double kPositionTolerance = 1e-11;
 struct Workspace {
   std::vector<ImpulseRow> rows;
   std::vector<double> a_kk;      // A_kk = 1/m_eff (eq. 7, i = k)
-  std::vector<double> vn;        // current v_n of each row (m/s), refreshed after every impulse
+  // Current v_n − t of each row (m/s), refreshed after every impulse: the approach beyond the row's
+  // target t = gap_target (0 unless the contact has a gap, then −gap/dt: it may close by the step's end).
+  std::vector<double> vn;
+  std::vector<double> target;    // t of each row (m/s, ≤ 0)
   std::vector<double> impulse;   // accumulated p ≥ 0 (N·s)
   std::vector<char> usable;      // false for rows whose A_kk is not a finite positive number
   std::vector<double> mu;        // Coulomb coefficient of each contact (combined_friction)
@@ -46,7 +49,8 @@ struct Workspace {
 // Refreshes v_n of every row that shares a movable body with row k (recomputed from the velocities).
 void refresh_neighbours(std::uint32_t k, Workspace& ws, std::span<const RigidBody> bodies) {
   for (const std::int32_t s : ws.incidence.slots[k])
-    for (std::uint32_t i : ws.incidence.rows_of(s)) ws.vn[i] = resolution::row_velocity(ws.rows[i], bodies);
+    for (std::uint32_t i : ws.incidence.rows_of(s))
+      ws.vn[i] = resolution::row_velocity(ws.rows[i], bodies) - ws.target[i];
 }
 
 // The frictional single-contact impulse at contact k (μ > 0): Mirtich's integration of the collision
@@ -58,8 +62,12 @@ bool apply_frictional_impulse(std::uint32_t k, double e, Workspace& ws, std::spa
   const Contact& c = ws.contacts[k];
   RigidBody& a = bodies[c.a];
   RigidBody& b = bodies[c.b];
-  const mirtich::FrictionalImpact impact = mirtich::integrate_frictional_impact(
-      mirtich::collision_matrix(a, b, c.point), relative_velocity(c, a, b), c.normal, ws.mu[k], e);
+  // An inelastic gap contact's target shifts the normal velocity the collision ends at: integrate from
+  // u − t n. A bouncing one bounces where it is (resting.hpp, "Gaps").
+  Vec3 u = relative_velocity(c, a, b);
+  if (ws.target[k] != 0.0 && e == 0.0) u -= ws.target[k] * c.normal;
+  const mirtich::FrictionalImpact impact =
+      mirtich::integrate_frictional_impact(mirtich::collision_matrix(a, b, c.point), u, c.normal, ws.mu[k], e);
   if (!impact.finite || !impact.impulse(c.normal).allFinite()) {
     ++counters.nan_caught;
     ws.usable[k] = 0;
@@ -74,7 +82,7 @@ bool apply_frictional_impulse(std::uint32_t k, double e, Workspace& ws, std::spa
   return true;
 }
 
-// Applies the single-contact impulse at row k, which approaches with v_n = ws.vn[k] < 0, and refreshes
+// Applies the single-contact impulse at row k, which approaches beyond its target (ws.vn[k] < 0), and refreshes
 // v_n of every row that shares a body with it (recomputed from the velocities, so no drift builds up).
 // Returns false (and applies nothing) if the impulse is not finite.
 bool apply_single_impulse(std::uint32_t k, Workspace& ws, std::span<RigidBody> bodies,
@@ -83,10 +91,11 @@ bool apply_single_impulse(std::uint32_t k, Workspace& ws, std::span<RigidBody> b
   // The impact speed is this contact's own approach speed: in a sequence of two-body collisions each
   // one is a separate event (Newton's cradle: the next contact approaches at full speed only after the
   // previous impulse). `ledas` judges the island as a whole instead; see README.md.
-  const double e = resolution::effective_restitution(row, -ws.vn[k], settings.resting);
+  const double e = resolution::effective_restitution(row, -(ws.vn[k] + ws.target[k]), settings.resting);
   if (ws.mu[k] > 0.0) return apply_frictional_impulse(k, e, ws, bodies, counters);
-  // Frictionless: the closed form below (unchanged, so frictionless scenes stay bit-identical).
-  const double p = -(1.0 + e) * ws.vn[k] / ws.a_kk[k];
+  // Frictionless: the closed form below. An inelastic contact stops at its target (a gap closes at the
+  // end of the step); a bouncing one leaves at e times its whole approach speed, where it is.
+  const double p = e == 0.0 ? -ws.vn[k] / ws.a_kk[k] : -(1.0 + e) * (ws.vn[k] + ws.target[k]) / ws.a_kk[k];
   if (!std::isfinite(p)) {
     ++counters.nan_caught;
     ws.usable[k] = 0;
@@ -239,7 +248,7 @@ MirtichResolver::MirtichResolver(const ModuleOptions& options) : settings_(Mirti
 MirtichResolver::MirtichResolver(const MirtichSettings& settings) : settings_(settings) {}
 
 void MirtichResolver::resolve(std::span<RigidBody> bodies, std::span<Contact> contacts,
-                              std::span<const Constraint> /*constraints*/, const StepContext& /*ctx*/,
+                              std::span<const Constraint> /*constraints*/, const StepContext& ctx,
                               ResolverCounters& counters) noexcept {
   try {
     Workspace ws;
@@ -248,6 +257,7 @@ void MirtichResolver::resolve(std::span<RigidBody> bodies, std::span<Contact> co
     for (const Contact& c : contacts) ws.rows.push_back(resolution::make_contact_row(bodies, c));
     ws.a_kk.resize(m);
     ws.vn.resize(m);
+    ws.target.resize(m);
     ws.impulse.assign(m, 0.0);
     ws.usable.assign(m, 1);
     ws.local.assign(m, 0);
@@ -258,7 +268,8 @@ void MirtichResolver::resolve(std::span<RigidBody> bodies, std::span<Contact> co
     for (std::uint32_t k = 0; k < m; ++k) {
       const ImpulseRow& row = ws.rows[k];
       ws.a_kk[k] = resolution::self_coupling(row);
-      ws.vn[k] = resolution::row_velocity(row, bodies);
+      ws.target[k] = resolution::gap_target(contacts[k].depth, ctx.dt);
+      ws.vn[k] = resolution::row_velocity(row, bodies) - ws.target[k];
       if (!(ws.a_kk[k] > 0.0) || !std::isfinite(ws.a_kk[k])) {
         ws.usable[k] = 0;  // e.g. a contact between two fixed bodies: no impulse can act on it
         if (!bodies[row.a].fixed || !bodies[row.b].fixed) ++counters.singular_systems;
@@ -279,7 +290,7 @@ void MirtichResolver::resolve(std::span<RigidBody> bodies, std::span<Contact> co
       counters.contacts += island.size();
     }
     // Quality is measured after the velocity sweep; the position correction does not change velocities.
-    const resolution::ContactResidual residual = resolution::measure_residual(ws.rows, ws.impulse, bodies);
+    const resolution::ContactResidual residual = resolution::measure_residual(ws.rows, ws.impulse, bodies, ws.target);
     counters.residual = std::max(counters.residual, residual.max_approach);
     counters.complementarity_error = std::max(counters.complementarity_error, residual.complementarity);
     record_outcomes(ws, contacts, bodies, settings_.tolerance, counters);

@@ -35,6 +35,9 @@ struct DetectorCounters {
   std::uint64_t pair_limit = 0;
   std::uint64_t crowded_body = 0;   ///< with pair_limit: the body in the most candidate pairs found
   std::uint64_t crowded_pairs = 0;  ///< with pair_limit: how many candidate pairs it was in when it stopped
+  /// Pairs whose contact search looked ahead by their closing motion over the step (speculative
+  /// contacts: a fast body met before it can pass through a thin one; 0 when nothing is fast).
+  std::uint64_t speculative_pairs = 0;
 };
 
 /// Resolver counters for one step.

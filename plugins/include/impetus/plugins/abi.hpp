@@ -31,7 +31,8 @@ class ModuleOptions;
 /// torque_body, motion); CollisionResolver::bodies_removed. 7: RigidBody::asleep (sleeping islands).
 /// 8: pathological scenes (DetectorCounters::pair_limit, crowded_body, crowded_pairs;
 /// ResolverCounters::work_limited, corrections_clamped, largest_correction).
-inline constexpr std::uint32_t kPluginAbiVersion = 8;
+/// 9: speculative contacts (DetectorCounters::speculative_pairs).
+inline constexpr std::uint32_t kPluginAbiVersion = 9;
 
 /// Name of the entry symbol every plugin exports.
 inline constexpr const char* kPluginEntrySymbol = "impetus_plugin_descriptor";

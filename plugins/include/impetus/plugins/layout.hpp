@@ -98,7 +98,7 @@ inline LayoutWords plugin_layout_words() {
   using DC = DetectorCounters;
   at(LayoutType::detector_counters) =
       layout_word<DC>(&DC::pairs_tested, &DC::narrowphase_calls, &DC::contacts, &DC::contacts_dropped,
-                              &DC::pair_limit, &DC::crowded_body, &DC::crowded_pairs);
+                              &DC::pair_limit, &DC::crowded_body, &DC::crowded_pairs, &DC::speculative_pairs);
   using RC = ResolverCounters;
   at(LayoutType::resolver_counters) =
       layout_word<RC>(&RC::islands, &RC::contacts, &RC::rounds, &RC::pulling_impulses, &RC::non_converged,

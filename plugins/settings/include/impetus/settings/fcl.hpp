@@ -30,8 +30,14 @@ struct FclDetectorSettings {
   int max_pairs_per_body = 16;
   /// The smallest pair limit, whatever the number of bodies.
   static constexpr std::size_t kMinPairLimit = 1024;
+  /// Speculative contacts: a pair that can close by more than the margin within one step, and by more
+  /// than half the thinner body's inner radius (so it could pass through it), is searched with its margin
+  /// grown by that closing distance; the resolvers let such a gap close exactly at the end of the step
+  /// and remove only the approach beyond it. false: the margin alone (fast bodies may tunnel).
+  bool speculative = true;
 
-  /// Reads `margin`, `max_contacts_per_pair`, `merge_tolerance` and `max_pairs_per_body`; throws OptionError on a bad value.
+  /// Reads `margin`, `max_contacts_per_pair`, `merge_tolerance`, `max_pairs_per_body` and `speculative`;
+  /// throws OptionError on a bad value.
   static FclDetectorSettings from_options(const ModuleOptions& options) {
     FclDetectorSettings s;
     s.margin = options.number("margin", s.margin, 0.0, 1e3);
@@ -40,6 +46,7 @@ struct FclDetectorSettings {
     s.merge_tolerance = options.number("merge_tolerance", s.merge_tolerance, 0.0, 0.5);
     s.max_pairs_per_body =
         static_cast<int>(options.integer("max_pairs_per_body", s.max_pairs_per_body, 0, 1'000'000));
+    s.speculative = options.boolean("speculative", s.speculative);
     return s;
   }
 
@@ -54,6 +61,7 @@ struct FclDetectorSettings {
     put(o, "merge_tolerance", merge_tolerance, d.merge_tolerance);
     put(o, "max_pairs_per_body", static_cast<long long>(max_pairs_per_body),
         static_cast<long long>(d.max_pairs_per_body));
+    put(o, "speculative", speculative, d.speculative);
     return o;
   }
 };

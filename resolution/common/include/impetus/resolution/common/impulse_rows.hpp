@@ -129,12 +129,20 @@ std::vector<std::vector<std::uint32_t>> find_islands(std::span<const ImpulseRow>
 
 /// Quality of a resolved contact set, measured from the bodies' velocities after resolution.
 struct ContactResidual {
-  double max_approach = 0.0;         ///< max over rows of max(0, −v_n⁺) (m/s)
-  double complementarity = 0.0;      ///< max over rows of |p · v_n⁺| (N·m/s)
+  double max_approach = 0.0;         ///< max over rows of max(0, t − v_n⁺) (m/s)
+  double complementarity = 0.0;      ///< max over rows of |p · (v_n⁺ − t)| (N·m/s)
 };
 
-/// Measures the residual of `rows` with their applied impulse magnitudes `impulses`.
+/// Measures the residual of `rows` with their applied impulse magnitudes `impulses`, against each row's
+/// target velocity t (`targets`; empty: t = 0 for every row). A contact with a gap g has t = −g/dt
+/// (gap_target): it may approach until the gap closes at the end of the step.
 ContactResidual measure_residual(std::span<const ImpulseRow> rows, std::span<const double> impulses,
-                                 std::span<const RigidBody> bodies);
+                                 std::span<const RigidBody> bodies, std::span<const double> targets = {});
+
+/// The lowest normal velocity a contact of depth `depth` needs after the step (m/s): 0 when touching or
+/// overlapping; −gap/dt for a gap (depth = −gap < 0), which closes exactly at the end of the step. A
+/// speculative contact (a fast body met a step ahead, detection/fcl/README.md) stops the body at the
+/// surface, never short of it.
+inline double gap_target(double depth, double dt) { return depth < 0.0 ? depth / dt : 0.0; }
 
 }  // namespace impetus::resolution

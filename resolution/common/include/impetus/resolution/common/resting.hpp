@@ -21,6 +21,14 @@
 /// the same direction) and counted in ResolverCounters::corrections_clamped. A consistent correction
 /// moves each point by at most the separations along its path to the support, so it never reaches L.
 ///
+/// **Gaps.** A contact found with a gap g (depth = −g < 0: within the detector's margin, or a speculative
+/// contact a fast body gets a step ahead) needs v_n⁺ ≥ −g/dt only (gap_target, impulse_rows.hpp): it may
+/// approach until the gap closes exactly at the end of the step, so an inelastic body lands on the
+/// surface, never short of it, and one that would not reach it this step gets no impulse. A contact that
+/// bounces (e > 0 above the threshold) and would close its gap within the step bounces where it is, with
+/// target 0: it leaves at e times its whole approach speed (no energy lost or gained) and turns back up to
+/// g early, as Box2D v3's speculative contacts do; the position error is at most (1 + e) g ≤ (1 + e)|v| dt.
+///
 /// A bounce threshold stops jitter: an island whose fastest approach is slower than `bounce_threshold`
 /// gets e = 0. It is judged per island, not per contact, because in a simultaneous impact touching
 /// contacts (v_n = 0) carry the restitution phase too (Newton's cradle: (1 + e) p on every contact).
