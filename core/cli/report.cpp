@@ -121,6 +121,7 @@ void RunStats::add_step(const World& world, const StepStatus& status) {
   singular_ += status.resolver.singular_systems;
   redundant_ += status.resolver.redundant_systems;
   work_limited_ += status.resolver.work_limited;
+  speculative_ += status.detector.speculative_pairs;
   clamped_ += status.resolver.corrections_clamped;
   largest_correction_ = std::max(largest_correction_, status.resolver.largest_correction);
   pulling_ += status.resolver.pulling_impulses;
@@ -235,7 +236,8 @@ json RunStats::summary(const World& world, double wall_seconds) const {
         {"detect", time_.detect},
         {"resolve", time_.resolve},
         {"integrate_positions", time_.positions}}},
-      {"contacts_per_step", {{"mean", static_cast<double>(contacts_) / steps}, {"max", max_contacts_}}},
+      {"contacts_per_step",
+       {{"mean", static_cast<double>(contacts_) / steps}, {"max", max_contacts_}, {"speculative_pairs", speculative_}}},
       {"resolver",
        {{"rounds", rounds_},
         {"max_rounds_per_step", max_rounds_},
@@ -328,6 +330,8 @@ void print_summary(const json& s, std::ostream& out) {
       << "contacts per step     mean " << s["contacts_per_step"]["mean"].get<double>() << ", max "
       << s["contacts_per_step"]["max"].get<std::uint64_t>();
   if (!s["contacts_per_step"].value("resolved", true)) out << " (detected, not resolved: resolver none)";
+  if (const std::uint64_t n = s["contacts_per_step"].value("speculative_pairs", std::uint64_t{0}); n > 0)
+    out << "; " << n << " pair tests looked ahead for fast bodies (speculative contacts)";
   out << "\n"
       << "resolver              " << r["rounds"].get<std::uint64_t>() << " rounds (max "
       << r["max_rounds_per_step"].get<std::uint64_t>() << " per step), " << r["non_converged"].get<std::uint64_t>()

@@ -70,6 +70,7 @@ class RunStats {
   std::uint64_t non_converged_ = 0, singular_ = 0, redundant_ = 0, pulling_ = 0, energy_gains_ = 0;
   std::uint64_t sticking_ = 0, sliding_ = 0;
   std::uint64_t work_limited_ = 0, clamped_ = 0;  // solves stopped by a work budget, corrections bounded
+  std::uint64_t speculative_ = 0;  // pairs the detector looked ahead for (fast bodies)
   double largest_correction_ = 0.0;               // m
   double friction_work_ = 0.0, max_natural_map_ = 0.0;
   double max_penetration_ = 0.0, max_residual_ = 0.0;

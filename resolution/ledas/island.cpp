@@ -118,14 +118,6 @@ ledas::Island LedasResolver::make_island(std::vector<std::uint32_t> rows, std::s
         ri.equality ? ri.target : ri.tangent ? 0.0 : resolution::gap_target(ri.depth, dt);
   }
   assign_restitution(island, bodies);
-  // A contact that bounces and would close its gap within the step bounces where it is (target 0), so
-  // it leaves at e times its full approach speed: the bounce loses no energy, and the body turns back up
-  // to the gap early (resolution/common/resting.hpp, "Gaps").
-  const ledas::Vector& v = current_velocities(island, bodies);
-  for (std::size_t i = 0; i < m; ++i) {
-    const auto ei = static_cast<Eigen::Index>(i);
-    if (island.restitution(ei) != 0.0 && v(ei) < island.target(ei)) island.target(ei) = 0.0;
-  }
   return island;
 }
 

@@ -464,6 +464,20 @@ TEST(CliSummary, BoundedCorrectionsAreReported) {
   EXPECT_NE(text.out.find("position corrections clamped"), std::string::npos) << text.out;
 }
 
+// assets/scenes/bullet_wall.yaml (a 2 cm ball at 200 m/s against a 5 cm wall): the summary counts the
+// pair tests the detector looked ahead for, in text and JSON, and none without the look-ahead; the ball
+// loses its 200 J to the wall (restitution 0) only with it.
+TEST(CliSummary, SpeculativeContactsAreCounted) {
+  const std::string args = "run " + std::string(IMPETUS_SOURCE_DIR) + "/assets/scenes/bullet_wall.yaml --duration 0.02";
+  const auto j = nlohmann::json::parse(run(args + " --json").out);
+  EXPECT_GT(j["contacts_per_step"]["speculative_pairs"].get<std::uint64_t>(), 0u) << j["contacts_per_step"].dump();
+  EXPECT_NEAR(j["energy"]["final_j"].get<double>(), 0.0, 1e-9) << j["energy"].dump();
+  EXPECT_NE(run(args).out.find("looked ahead for fast bodies"), std::string::npos);
+  const auto off = nlohmann::json::parse(run(args + " --set modules.detector.speculative=false --json").out);
+  EXPECT_EQ(off["contacts_per_step"]["speculative_pairs"].get<std::uint64_t>(), 0u);
+  EXPECT_NEAR(off["energy"]["final_j"].get<double>(), 200.0, 1e-9) << off["energy"].dump();
+}
+
 // The friction line says "none" where no body has friction (drop.yaml): its stick/slide counts would
 // only tell which frictionless contacts had no tangential velocity. With friction (slope.yaml) it counts
 // sliding contacts and the energy friction dissipated (> 0 for a box sliding 1 s).
