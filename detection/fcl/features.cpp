@@ -221,6 +221,9 @@ Feature supporting_feature(const Placed& s, const Vec3& d, const FeatureToleranc
   return f;
 }
 
+// A convex hull with at most this many distinct face normals offers all of them as candidate axes.
+constexpr std::size_t kAllFaceNormals = 24;  // two such hulls and the hint fit the 64 candidates
+
 void candidate_axes(const Placed& s, const Vec3& hint, const Vec3& other_center, SmallVec<Vec3, 64>& out) {
   const auto radial = [&] {
     const Vec3 u = s.axis(), d = other_center - s.x;
@@ -236,13 +239,17 @@ void candidate_axes(const Placed& s, const Vec3& hint, const Vec3& other_center,
       out.push_back(s.axis());
       radial();
       break;
-    case ShapeKind::convex:
-      // Only faces nearly facing the contact can be the separating axis the narrowphase missed.
+    case ShapeKind::convex: {
+      // Only faces nearly facing the contact can be the separating axis the narrowphase missed. A hull
+      // with few faces gives them all: the hint can be far off (FCL's EPA on a thin hull touched
+      // exactly: a ball resting on a 1 cm plate got a normal 84° from the face).
+      const bool all = s.geometry->mesh->face_normals.size() <= kAllFaceNormals;
       for (const Vec3& n : s.geometry->mesh->face_normals) {
         const Vec3 w = s.R * n;
-        if (std::abs(w.dot(hint)) >= 0.9 && !out.push_back(w)) break;
+        if ((all || std::abs(w.dot(hint)) >= 0.9) && !out.push_back(w)) break;
       }
       break;
+    }
     default: break;
   }
 }

@@ -192,5 +192,85 @@ TEST(FclPairs, RandomPairsHaveFiniteOutwardNormalsAndConsistentDepths) {
   EXPECT_GT(checked, 500u);
 }
 
+/// A fixed convex plate 2 m × 2 m × 1 cm (8 vertices, 6 faces) with its top face at z = 0.
+RigidBody thin_plate(MeshCollision collision) {
+  std::vector<Vec3> v;
+  for (int i = 0; i < 8; ++i) v.emplace_back((i & 1) ? 1.0 : -1.0, (i & 2) ? 1.0 : -1.0, (i & 4) ? 0.005 : -0.005);
+  const auto mesh =
+      mesh_from_faces(v, {{0, 2, 4, 6}, {1, 3, 5, 7}, {0, 1, 4, 5}, {2, 3, 6, 7}, {0, 1, 2, 3}, {4, 5, 6, 7}});
+  return make_body("plate", mesh_shape(mesh, collision), Vec3(0, 0, -0.005), Mat3::Identity(), true);
+}
+
+// A 2 cm ball on a thin convex plate, touching exactly, overlapping by 1e-12 m and 1e-5 m, and 5e-5 m
+// above it, at several places: one contact, normal +z and depth to 1e-9. FCL's EPA gave a normal 84° off
+// for the exact touch (depth 1.13 m) before every face of a small hull became a candidate axis.
+TEST(FclPairs, BallTouchingAThinConvexPlate) {
+  for (const double gap : {0.0, -1e-12, -1e-5, 5e-5}) {
+    for (const Vec3& at : {Vec3(0.1, 0.2, 0), Vec3(0.7, -0.3, 0), Vec3(0, 0, 0), Vec3(-0.95, 0.9, 0)}) {
+      SCOPED_TRACE("gap " + std::to_string(gap) + " at " + std::to_string(at.x()) + ", " + std::to_string(at.y()));
+      const std::vector<RigidBody> bodies{thin_plate(MeshCollision::convex),
+                                          make_body("ball", Sphere{0.02}, at + Vec3(0, 0, 0.02 + gap))};
+      const std::vector<Contact> contacts = detect_once(bodies);
+      ASSERT_EQ(contacts.size(), 1u);
+      EXPECT_LT((contacts[0].normal - Vec3::UnitZ()).norm(), 1e-9) << contacts[0].normal.transpose();
+      EXPECT_NEAR(contacts[0].depth, -gap, 1e-9);
+    }
+  }
+}
+
+// Speculative contacts at the detector (detection/fcl/README.md, "Fast bodies"): a 2 cm ball 10 cm above
+// a thin plate, at dt = 1 ms.
+TEST(FclSpeculative, AFastBallIsMetAStepAheadAndASlowOneIsNot) {
+  StepContext ctx;
+  ctx.dt = 1e-3;
+  for (const MeshCollision collision : {MeshCollision::convex, MeshCollision::triangles}) {
+    for (const bool speculative : {true, false}) {
+      std::vector<RigidBody> bodies{thin_plate(collision), make_body("ball", Sphere{0.02}, Vec3(0.1, 0.2, 0.12))};
+      FclDetectorSettings settings;
+      settings.speculative = speculative;
+      FclDetector detector(settings);
+      ASSERT_TRUE(detector.set_bodies(bodies, {}).ok);
+      const auto detect = [&](const Vec3& velocity) {
+        bodies[1].velocity = velocity;
+        std::vector<Contact> contacts;
+        DetectorCounters counters;
+        detector.detect(bodies, ctx, contacts, counters);
+        return std::pair{contacts, counters.speculative_pairs};
+      };
+      // 300 m/s down: it would cross 30 cm this step. With the look-ahead the face is a contact with
+      // depth −0.1 m, normal +z (and the triangle mesh's neighbouring edge, further); without, nothing.
+      const auto [down, down_pairs] = detect(Vec3(0, 0, -300));
+      if (speculative) {
+        EXPECT_EQ(down_pairs, 1u);
+        ASSERT_FALSE(down.empty());
+        const auto nearest = std::max_element(down.begin(), down.end(),
+                                              [](const Contact& l, const Contact& r) { return l.depth < r.depth; });
+        EXPECT_NEAR(nearest->depth, -0.1, 1e-12);
+        EXPECT_LT((nearest->normal - Vec3::UnitZ()).norm(), 1e-12);
+      } else {
+        EXPECT_EQ(down_pairs, 0u);
+        EXPECT_TRUE(down.empty());
+      }
+      // 300 m/s sideways: the gap never closes, so conservative advancement drops the pair's contacts.
+      const auto [side, side_pairs] = detect(Vec3(300, 0, 0));
+      EXPECT_TRUE(side.empty());
+      // 90 m/s down: 9 cm this step, short of the 10 cm gap: no contact either.
+      const auto [short_of, short_pairs] = detect(Vec3(0, 0, -90));
+      EXPECT_TRUE(short_of.empty());
+      // 2 m/s down from 1 mm above: 2 mm per step, less than half the hull's 5 mm inner radius, so the
+      // hull gets no look-ahead (the ball sinks 1 mm and the position correction lifts it); the triangle
+      // mesh counts as thin anywhere and meets the ball on its face.
+      bodies[1].position.z() = 0.021;
+      const auto [slow, slow_pairs] = detect(Vec3(0, 0, -2));
+      const bool ahead = speculative && collision == MeshCollision::triangles;
+      EXPECT_EQ(slow_pairs, ahead ? 1u : 0u);
+      ASSERT_EQ(slow.size(), ahead ? 1u : 0u);
+      if (ahead) {
+        EXPECT_NEAR(slow[0].depth, -0.001, 1e-12);
+      }
+    }
+  }
+}
+
 }  // namespace
 }  // namespace impetus::test
