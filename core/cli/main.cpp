@@ -21,6 +21,7 @@
 #include <iostream>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace fs = std::filesystem;
@@ -124,8 +125,42 @@ nlohmann::json options_json(const ModuleOptions& options) {
   return out;
 }
 
+// What `run` writes besides its summary.
+struct RunOutputs {
+  std::string trajectory;  // --out (and its body table beside it)
+  std::string contacts;    // --contacts
+  bool overwrite = false;
+  std::uint64_t every = 1;
+
+  // The body table goes beside a trajectory written to a file, not beside a device or a pipe
+  // (/dev/stdout, /dev/full).
+  bool body_table() const {
+    std::error_code ec;
+    return !trajectory.empty() &&
+           (!std::filesystem::exists(trajectory, ec) || std::filesystem::is_regular_file(trajectory, ec));
+  }
+};
+
+// Checks every output path before any file is created, so a bad --contacts leaves no empty --out behind,
+// and refuses two outputs naming one file.
+void check_outputs(const RunOutputs& outputs, const std::filesystem::path& scene) {
+  std::vector<std::pair<std::string, std::filesystem::path>> files;
+  if (!outputs.trajectory.empty()) {
+    files.emplace_back("--out", outputs.trajectory);
+    if (outputs.body_table()) files.emplace_back("--out (its body table)", cli::body_table_path(outputs.trajectory));
+  }
+  if (!outputs.contacts.empty()) files.emplace_back("--contacts", outputs.contacts);
+  for (std::size_t i = 0; i < files.size(); ++i) {
+    cli::check_output_path(files[i].second, outputs.overwrite, scene, files[i].first);
+    for (std::size_t j = 0; j < i; ++j)
+      if (std::filesystem::weakly_canonical(files[i].second) == std::filesystem::weakly_canonical(files[j].second))
+        throw Error(files[i].first + " " + files[i].second.string() + ": is also the file of " + files[j].first +
+                    "; each output needs its own file");
+  }
+}
+
 int run_command(const SceneArgs& args, std::optional<std::uint64_t> steps, std::optional<double> duration,
-                const std::string& out_file, bool overwrite, std::uint64_t every, bool json) {
+                const RunOutputs& outputs, bool json) {
   const Scene scene = load(args);
   PluginHost host;
   std::unique_ptr<World> world = build_world(scene, host);
@@ -146,11 +181,16 @@ int run_command(const SceneArgs& args, std::optional<std::uint64_t> steps, std::
     throw Error("--steps " + std::to_string(*steps) + ": more than the " + format_number(kMaxSteps) +
                 " a run can count exactly (2^53)");
 
+  check_outputs(outputs, scene.file);
   std::optional<cli::TrajectoryWriter> writer;
-  if (!out_file.empty()) {
-    writer.emplace(out_file, overwrite, scene.file);
+  if (!outputs.trajectory.empty()) {
+    if (outputs.body_table())
+      cli::write_body_table(cli::body_table_path(outputs.trajectory), outputs.overwrite, scene.file, *world);
+    writer.emplace(outputs.trajectory, outputs.overwrite, scene.file);
     writer->write(*world);
   }
+  std::optional<cli::ContactWriter> contact_log;
+  if (!outputs.contacts.empty()) contact_log.emplace(outputs.contacts, outputs.overwrite, scene.file);
   cli::RunStats stats(*world);
   Progress progress(total);
   const auto start = Clock::now();
@@ -168,11 +208,15 @@ int run_command(const SceneArgs& args, std::optional<std::uint64_t> steps, std::
                   format_number(world->time()) + " s): the run's " + what +
                   " is no longer finite (velocities, masses or the time step too large to square)");
     }
-    if (writer && (world->step_count() % every == 0 || i + 1 == total)) writer->write(*world);
+    if (world->step_count() % outputs.every == 0 || i + 1 == total) {
+      if (writer) writer->write(*world);
+      if (contact_log) contact_log->write(*world);
+    }
     progress.update(*world);
   }
   progress.done();
   if (writer) writer->finish();
+  if (contact_log) contact_log->finish();
   const double wall = std::chrono::duration<double>(Clock::now() - start).count();
   nlohmann::json summary = stats.summary(*world, wall);
   summary["scene"] = scene.file.string();
@@ -188,7 +232,12 @@ int run_command(const SceneArgs& args, std::optional<std::uint64_t> steps, std::
     std::cout << summary.dump(2) << "\n";
   } else {
     cli::print_summary(summary, std::cout);
-    if (!out_file.empty()) std::cout << "trajectory            " << out_file << "\n";
+    if (!outputs.trajectory.empty()) {
+      std::cout << "trajectory            " << outputs.trajectory;
+      if (outputs.body_table()) std::cout << " (bodies: " << cli::body_table_path(outputs.trajectory).string() << ")";
+      std::cout << "\n";
+    }
+    if (!outputs.contacts.empty()) std::cout << "contact log           " << outputs.contacts << "\n";
   }
   return 0;
 }
@@ -233,9 +282,8 @@ int main(int argc, char** argv) {
   SceneArgs run_args;
   std::optional<std::uint64_t> steps;
   std::optional<double> duration;
-  std::string out_file;
-  bool overwrite = false, run_json = false;
-  std::uint64_t every = 1;
+  RunOutputs outputs;
+  bool run_json = false;
   auto* run = app.add_subcommand("run", "simulate a scene (no SCENE: the bundled demo) and print a summary");
   add_scene_options(run, run_args, false);
   run->footer(kRunSummaryHelp);
@@ -244,9 +292,14 @@ int main(int argc, char** argv) {
   run->add_option("--dt", run_args.dt, "time step in seconds (overrides dt)")->check(CLI::PositiveNumber);
   run->add_option("--integrator", run_args.integrator, "integrator plugin (overrides modules.integrator)")->type_name("NAME");
   run->add_option("--detector", run_args.detector, "detector plugin (overrides modules.detector)")->type_name("NAME");
-  run->add_option("--out", out_file, "write the trajectory as CSV: step,time,body,x,y,z,qw,qx,qy,qz,vx,vy,vz,wx,wy,wz");
-  run->add_flag("--overwrite", overwrite, "allow --out to replace an existing file");
-  run->add_option("--every", every, "with --out: record every N-th step (default 1)")->check(CLI::PositiveNumber);
+  run->add_option("--out", outputs.trajectory,
+                  "write the trajectory as CSV: step,time,body,x,y,z,qw,qx,qy,qz,vx,vy,vz,wx,wy,wz, and the bodies "
+                  "(name, mass, shape, sizes) beside it as FILE.bodies.csv");
+  run->add_option("--contacts", outputs.contacts,
+                  "write the contact log as CSV: step,time,a,b,x,y,z,nx,ny,nz,depth,impulse,tx,ty,tz,mode");
+  run->add_flag("--overwrite", outputs.overwrite, "allow --out and --contacts to replace existing files");
+  run->add_option("--every", outputs.every, "with --out or --contacts: record every N-th step (default 1)")
+      ->check(CLI::PositiveNumber);
   run->add_flag("--json", run_json, "print the summary as JSON");
 
   SceneArgs resolve_args;
@@ -287,7 +340,7 @@ int main(int argc, char** argv) {
   }
 
   try {
-    if (run->parsed()) return run_command(run_args, steps, duration, out_file, overwrite, every, run_json);
+    if (run->parsed()) return run_command(run_args, steps, duration, outputs, run_json);
     if (resolve->parsed()) return resolve_command(resolve_args, resolve_json);
     if (mass->parsed()) return cli::run_mass_command(mass_args);
     if (fclib_solve->parsed()) return cli::run_fclib_solve(fclib_solve_args);

@@ -9,6 +9,8 @@
 #include <cmath>
 #include <cstdio>
 #include <iomanip>
+#include <type_traits>
+#include <variant>
 #include <ostream>
 
 namespace impetus::cli {
@@ -380,42 +382,133 @@ void check_output_path(const std::filesystem::path& out, bool overwrite, const s
   if (!overwrite) throw Error(name + ": file exists; pass --overwrite to replace it");
 }
 
-TrajectoryWriter::TrajectoryWriter(const std::filesystem::path& file, bool overwrite,
-                                   const std::filesystem::path& input)
+CsvFile::CsvFile(const std::filesystem::path& file, bool overwrite, const std::filesystem::path& input,
+                 const std::string& option, const std::string& header)
     : file_(file) {
-  check_output_path(file, overwrite, input, "--out");
+  check_output_path(file, overwrite, input, option);
   out_.open(file, std::ios::out | std::ios::trunc);
   if (!out_) throw Error(file.string() + ": cannot open for writing");
-  out_ << "step,time,body,x,y,z,qw,qx,qy,qz,vx,vy,vz,wx,wy,wz\n";
+  put(header);
 }
 
-void TrajectoryWriter::finish() {
+void CsvFile::put(const std::string& text) {
+  out_ << text;
+  if (!out_) throw Error(file_.string() + ": writing failed (the device is full or the file cannot be written)");
+}
+
+void CsvFile::finish() {
   out_.flush();
   out_.close();
   if (!out_) throw Error(file_.string() + ": writing failed (the device is full or the file cannot be written)");
 }
 
+TrajectoryWriter::TrajectoryWriter(const std::filesystem::path& file, bool overwrite,
+                                   const std::filesystem::path& input)
+    : csv_(file, overwrite, input, "--out", "step,time,body,x,y,z,qw,qx,qy,qz,vx,vy,vz,wx,wy,wz\n") {}
+
 void TrajectoryWriter::write(const World& world) {
-  std::string line;
+  std::string lines, step_time;
+  step_time += std::to_string(world.step_count());
+  step_time += ',';
+  append_number(step_time, world.time());
+  step_time += ',';
   for (const RigidBody& b : world.bodies()) {
-    line.clear();
-    line += std::to_string(world.step_count());
-    line += ',';
-    append_number(line, world.time());
-    line += ',';
-    append_csv_text(line, b.name);
+    lines += step_time;
+    append_csv_text(lines, b.name);
     const Quat q = b.orientation();
     const double values[] = {b.position.x(), b.position.y(), b.position.z(), q.w(), q.x(), q.y(), q.z(),
                              b.velocity.x(), b.velocity.y(), b.velocity.z(), b.angular_velocity.x(),
                              b.angular_velocity.y(), b.angular_velocity.z()};
     for (double v : values) {
-      line += ',';
-      append_number(line, v);
+      lines += ',';
+      append_number(lines, v);
     }
-    line += '\n';
-    out_ << line;
+    lines += '\n';
   }
-  if (!out_) throw Error(file_.string() + ": writing failed (the device is full or the file cannot be written)");
+  csv_.put(lines);
+}
+
+ContactWriter::ContactWriter(const std::filesystem::path& file, bool overwrite, const std::filesystem::path& input)
+    : csv_(file, overwrite, input, "--contacts", "step,time,a,b,x,y,z,nx,ny,nz,depth,impulse,tx,ty,tz,mode\n") {}
+
+void ContactWriter::write(const World& world) {
+  const auto bodies = world.bodies();
+  std::string lines, step_time;
+  step_time += std::to_string(world.step_count());
+  step_time += ',';
+  append_number(step_time, world.time());
+  step_time += ',';
+  for (const Contact& c : world.contacts()) {
+    lines += step_time;
+    append_csv_text(lines, bodies[c.a].name);
+    lines += ',';
+    append_csv_text(lines, bodies[c.b].name);
+    const double values[] = {c.point.x(),  c.point.y(), c.point.z(), c.normal.x(),          c.normal.y(),
+                             c.normal.z(), c.depth,     c.impulse,   c.tangent_impulse.x(), c.tangent_impulse.y(),
+                             c.tangent_impulse.z()};
+    for (double v : values) {
+      lines += ',';
+      append_number(lines, v);
+    }
+    lines += ',';
+    lines += contact_mode_name(c.mode);
+    lines += '\n';
+  }
+  csv_.put(lines);
+}
+
+std::filesystem::path body_table_path(const std::filesystem::path& trajectory) {
+  std::filesystem::path out = trajectory;
+  if (out.extension() == ".csv") out.replace_extension();
+  out += ".bodies.csv";
+  return out;
+}
+
+void write_body_table(const std::filesystem::path& file, bool overwrite, const std::filesystem::path& input,
+                      const World& world) {
+  CsvFile csv(file, overwrite, input, "--out (its body table)",
+              "name,mass,fixed,shape,radius,length,size_x,size_y,size_z,normal_x,normal_y,normal_z,offset,"
+              "mesh,scale,collision\n");
+  std::string lines;
+  for (const RigidBody& b : world.bodies()) {
+    append_csv_text(lines, b.name);
+    lines += ',';
+    append_number(lines, b.fixed ? 0.0 : b.mass);
+    lines += b.fixed ? ",true," : ",false,";
+    lines += shape_kind_name(b.shape);
+    // radius,length | size_x,size_y,size_z | normal_x,normal_y,normal_z,offset | mesh,scale,collision
+    std::string fields[12];
+    const auto number = [](double x) { return format_number(x); };
+    std::visit(
+        [&](const auto& shape) {
+          using T = std::decay_t<decltype(shape)>;
+          if constexpr (std::is_same_v<T, Sphere>) {
+            fields[0] = number(shape.radius);
+          } else if constexpr (std::is_same_v<T, Capsule> || std::is_same_v<T, Cylinder>) {
+            fields[0] = number(shape.radius);
+            fields[1] = number(shape.length);
+          } else if constexpr (std::is_same_v<T, Box>) {
+            for (int i = 0; i < 3; ++i) fields[2 + i] = number(shape.size[i]);
+          } else if constexpr (std::is_same_v<T, Plane>) {
+            for (int i = 0; i < 3; ++i) fields[5 + i] = number(shape.normal[i]);
+            fields[8] = number(shape.offset);
+          } else if constexpr (std::is_same_v<T, MeshShape>) {
+            std::string file_field;
+            append_csv_text(file_field, shape.file.string());
+            fields[9] = file_field;
+            fields[10] = number(shape.scale);
+            fields[11] = shape.collision == MeshCollision::convex ? "convex" : "triangles";
+          }
+        },
+        b.shape);
+    for (const std::string& f : fields) {
+      lines += ',';
+      lines += f;
+    }
+    lines += '\n';
+  }
+  csv.put(lines);
+  csv.finish();
 }
 
 json resolve_report(const World& world, const std::string& resolver, double seconds) {

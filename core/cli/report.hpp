@@ -85,13 +85,14 @@ void print_summary(const nlohmann::json& summary, std::ostream& out);
 void check_output_path(const std::filesystem::path& out, bool overwrite, const std::filesystem::path& input,
                        const std::string& option);
 
-/// Writes one CSV row per body per recorded step: step,time,body,x,y,z,qw,qx,qy,qz,vx,vy,vz,wx,wy,wz.
-/// Numbers use the shortest text that reads back to the same double, so the file is bit-exact.
-class TrajectoryWriter {
+/// A CSV file the tool writes: its path is checked first (check_output_path, naming `option`), every
+/// write is checked, and finish() checks the final flush, so a full disk is an error, never a short file.
+class CsvFile {
  public:
-  /// Opens `file` for writing after check_output_path (`input`: the scene being run).
-  TrajectoryWriter(const std::filesystem::path& file, bool overwrite, const std::filesystem::path& input);
-  void write(const World& world);
+  CsvFile(const std::filesystem::path& file, bool overwrite, const std::filesystem::path& input,
+          const std::string& option, const std::string& header);
+  /// Writes `text` (whole lines); throws Error if the write failed.
+  void put(const std::string& text);
   /// Flushes and closes the file; throws Error if any write failed (a full disk, /dev/full).
   void finish();
 
@@ -99,6 +100,40 @@ class TrajectoryWriter {
   std::filesystem::path file_;
   std::ofstream out_;
 };
+
+/// Writes one CSV row per body per recorded step: step,time,body,x,y,z,qw,qx,qy,qz,vx,vy,vz,wx,wy,wz.
+/// Numbers use the shortest text that reads back to the same double, so the file is bit-exact.
+class TrajectoryWriter {
+ public:
+  /// Opens `file` for writing after check_output_path (`input`: the scene being run).
+  TrajectoryWriter(const std::filesystem::path& file, bool overwrite, const std::filesystem::path& input);
+  void write(const World& world);
+  void finish() { csv_.finish(); }
+
+ private:
+  CsvFile csv_;
+};
+
+/// Writes the contact log (`--contacts`): one row per contact of the step just taken, with the impulses
+/// the resolver applied: step,time,a,b,x,y,z,nx,ny,nz,depth,impulse,tx,ty,tz,mode (README.md, "The
+/// `impetus` tool"). Same number format as the trajectory.
+class ContactWriter {
+ public:
+  ContactWriter(const std::filesystem::path& file, bool overwrite, const std::filesystem::path& input);
+  void write(const World& world);
+  void finish() { csv_.finish(); }
+
+ private:
+  CsvFile csv_;
+};
+
+/// The body table beside a trajectory: `run.csv` → `run.bodies.csv` (any other name gains `.bodies.csv`).
+std::filesystem::path body_table_path(const std::filesystem::path& trajectory);
+
+/// Writes the body table (name, mass, fixed, shape and its sizes, mesh file, scale and collision), one
+/// row per body, so an analysis of the trajectory needs nothing but the files.
+void write_body_table(const std::filesystem::path& file, bool overwrite, const std::filesystem::path& input,
+                      const World& world);
 
 /// The `resolve --json` document (README.md, "The `impetus` tool").
 nlohmann::json resolve_report(const World& world, const std::string& resolver, double seconds);

@@ -222,6 +222,65 @@ TEST(Cli, OutputsThatWouldLoseDataAreRefused) {
   EXPECT_FALSE(fs::exists(target));
 }
 
+// The contact log and the body table (README.md, "The `impetus` tool"): bullet_wall.yaml's 10 g ball at
+// 200 m/s stops on the wall (restitution 0), so the normal impulses of the log add up to its momentum,
+// 2 N s, to rounding; every row has 16 fields, names the wall and the bullet, and has a unit normal. The
+// body table gives each body's mass and sizes as the scene wrote them.
+TEST(Cli, ContactLogAndBodyTable) {
+  const fs::path out = temp_file("wall.csv"), contacts = temp_file("wall_contacts.csv");
+  const fs::path bodies = temp_file("wall.bodies.csv");
+  const std::string wall = std::string(IMPETUS_SOURCE_DIR) + "/assets/scenes/bullet_wall.yaml";
+  const Result r = run("run " + wall + " --duration 0.02 --overwrite --out " + out.string() + " --contacts " +
+                       contacts.string());
+  ASSERT_EQ(r.status, 0) << r.out;
+  EXPECT_NE(r.out.find("contact log"), std::string::npos) << r.out;
+  std::istringstream log(read(contacts));
+  std::string line;
+  std::getline(log, line);
+  EXPECT_EQ(line, "step,time,a,b,x,y,z,nx,ny,nz,depth,impulse,tx,ty,tz,mode");
+  double total = 0.0;
+  int rows = 0;
+  while (std::getline(log, line)) {
+    std::vector<std::string> f;
+    std::stringstream fields(line);
+    for (std::string x; std::getline(fields, x, ',');) f.push_back(x);
+    ASSERT_EQ(f.size(), 16u) << line;
+    EXPECT_EQ(f[2], "wall");
+    EXPECT_EQ(f[3], "bullet");
+    EXPECT_NEAR(std::hypot(std::stod(f[7]), std::stod(f[8]), std::stod(f[9])), 1.0, 1e-12) << line;
+    total += std::stod(f[11]);
+    ++rows;
+  }
+  EXPECT_GT(rows, 0);
+  EXPECT_NEAR(total, 0.01 * 200.0, 1e-12);
+  EXPECT_EQ(read(bodies), "name,mass,fixed,shape,radius,length,size_x,size_y,size_z,normal_x,normal_y,normal_z,"
+                          "offset,mesh,scale,collision\n"
+                          "wall,0,true,box,,,0.05,2,2,,,,,,,\n"
+                          "bullet,0.01,false,sphere,0.01,,,,,,,,,,,\n");
+
+  // Existing files are kept without --overwrite (the body table too), and two outputs cannot share a
+  // file; nothing is written when a path is refused.
+  const std::string kept = read(contacts);
+  const Result again = run("run " + wall + " --duration 0.02 --contacts " + contacts.string());
+  EXPECT_NE(again.status, 0);
+  EXPECT_NE(again.out.find("--contacts " + contacts.string() + ": file exists"), std::string::npos) << again.out;
+  EXPECT_EQ(read(contacts), kept);
+  const fs::path fresh = temp_file("fresh.csv");
+  fs::remove(fresh);
+  { std::ofstream(temp_file("fresh.bodies.csv")) << "mine\n"; }
+  const Result table = run("run " + wall + " --duration 0.02 --out " + fresh.string());
+  EXPECT_NE(table.out.find("its body table"), std::string::npos) << table.out;
+  EXPECT_FALSE(fs::exists(fresh));
+  EXPECT_EQ(read(temp_file("fresh.bodies.csv")), "mine\n");
+  const Result shared = run("run " + wall + " --duration 0.02 --overwrite --out " + out.string() + " --contacts " +
+                            out.string());
+  EXPECT_NE(shared.status, 0);
+  EXPECT_NE(shared.out.find("each output needs its own file"), std::string::npos) << shared.out;
+  const Result full = run("run " + wall + " --duration 0.02 --overwrite --contacts /dev/full");
+  EXPECT_NE(full.status, 0);
+  EXPECT_NE(full.out.find("/dev/full: writing failed"), std::string::npos) << full.out;
+}
+
 // A body name with a comma or a quote is one CSV field (RFC 4180 quoting); the row keeps 16 fields.
 TEST(Cli, NamesWithCommasAreQuotedInTheTrajectory) {
   const fs::path f = temp_file("quoted.csv");
