@@ -430,8 +430,12 @@ bool FclDetector::Impl::meets_within_step(const Placed& a, const Placed& b, cons
     const double gap = -closest.depth;
     if (gap <= margin) break;
     const double rate = (convex ? std::abs(dv.dot(closest.normal)) : dv.norm()) + spin;
+    if (!(rate > 0.0)) {  // the gap cannot close
+      meets = false;
+      break;
+    }
     tau += (gap - 0.5 * margin) / rate;
-    if (!(tau < dt)) {  // also a rate of 0: the gap cannot close
+    if (!(tau < dt)) {
       meets = false;
       break;
     }
