@@ -14,6 +14,8 @@ packages=(
   libbullet-dev libode-dev libmujoco-dev python3-matplotlib
   # fuzzing (libFuzzer) and the sanitizer run
   clang libclang-rt-dev
+  # glTF 2.0 export of runs (core/cli/gltf_export.cpp)
+  libtinygltf-dev
 )
 
 as_root=()
@@ -24,3 +26,12 @@ fi
 export DEBIAN_FRONTEND=noninteractive
 "${as_root[@]}" apt-get update
 "${as_root[@]}" apt-get install -y --no-install-recommends "${packages[@]}"
+
+# The Khronos glTF-Validator (npm, pinned in tests/gltf/package-lock.json) for the glTF export tests, with
+# the machine's Node.js and npm.
+root=$(cd "$(dirname "$0")/.." && pwd)
+if command -v npm >/dev/null && command -v node >/dev/null; then
+  npm ci --prefix "$root/tests/gltf" --no-audit --no-fund --loglevel=error
+else
+  echo "setup.sh: Node.js and npm not found: the glTF validation test (tests/cli/test_gltf.cpp) will fail" >&2
+fi

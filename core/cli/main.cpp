@@ -2,6 +2,7 @@
 // Contract: README.md, "The `impetus` tool", documents every option.
 
 #include "fclib_command.hpp"
+#include "gltf_export.hpp"
 #include "mass_command.hpp"
 #include "report.hpp"
 
@@ -134,9 +135,10 @@ struct RunOutputs {
 
   // The body table goes beside a trajectory written to a file, not beside a device or a pipe
   // (/dev/stdout, /dev/full).
+  bool gltf() const { return !trajectory.empty() && cli::is_gltf_path(trajectory); }
   bool body_table() const {
     std::error_code ec;
-    return !trajectory.empty() &&
+    return !trajectory.empty() && !gltf() &&
            (!std::filesystem::exists(trajectory, ec) || std::filesystem::is_regular_file(trajectory, ec));
   }
 };
@@ -183,7 +185,13 @@ int run_command(const SceneArgs& args, std::optional<std::uint64_t> steps, std::
 
   check_outputs(outputs, scene.file);
   std::optional<cli::TrajectoryWriter> writer;
-  if (!outputs.trajectory.empty()) {
+  std::optional<cli::GltfRecorder> animation;
+  if (outputs.gltf()) {
+    animation.emplace(outputs.trajectory, outputs.overwrite, scene.file, *world, total / outputs.every + 2,
+                      cli::GltfRunInfo{scene.file.string(), scene.integrator.plugin, scene.detector.plugin,
+                                       scene.resolver.plugin, IMPETUS_VERSION});
+    animation->record(*world);
+  } else if (!outputs.trajectory.empty()) {
     if (outputs.body_table())
       cli::write_body_table(cli::body_table_path(outputs.trajectory), outputs.overwrite, scene.file, *world);
     writer.emplace(outputs.trajectory, outputs.overwrite, scene.file);
@@ -210,12 +218,14 @@ int run_command(const SceneArgs& args, std::optional<std::uint64_t> steps, std::
     }
     if (world->step_count() % outputs.every == 0 || i + 1 == total) {
       if (writer) writer->write(*world);
+      if (animation) animation->record(*world);
       if (contact_log) contact_log->write(*world);
     }
     progress.update(*world);
   }
   progress.done();
   if (writer) writer->finish();
+  if (animation) animation->finish(*world);
   if (contact_log) contact_log->finish();
   const double wall = std::chrono::duration<double>(Clock::now() - start).count();
   nlohmann::json summary = stats.summary(*world, wall);
@@ -294,7 +304,8 @@ int main(int argc, char** argv) {
   run->add_option("--detector", run_args.detector, "detector plugin (overrides modules.detector)")->type_name("NAME");
   run->add_option("--out", outputs.trajectory,
                   "write the trajectory as CSV: step,time,body,x,y,z,qw,qx,qy,qz,vx,vy,vz,wx,wy,wz, and the bodies "
-                  "(name, mass, shape, sizes) beside it as FILE.bodies.csv");
+                  "(name, mass, shape, sizes) beside it as FILE.bodies.csv; or, for FILE.glb / FILE.gltf, as a glTF "
+                  "2.0 animation of the bodies' shapes");
   run->add_option("--contacts", outputs.contacts,
                   "write the contact log as CSV: step,time,a,b,x,y,z,nx,ny,nz,depth,impulse,tx,ty,tz,mode");
   run->add_flag("--overwrite", outputs.overwrite, "allow --out and --contacts to replace existing files");
