@@ -399,11 +399,11 @@ void FclDetector::Impl::narrow(const Placed& a, const Placed& b, const Body& ba,
 }
 
 // Conservative advancement over the step (the classic time-of-impact bound, as FCL's continuous
-// collision and Mirtich's thesis use it): the bodies
-// move on at their current velocities by the largest time their gap allows — gap over a bound on how
-// fast it can close (the relative velocity along the closest normal, plus |ω| times each bounding radius)
-// — until the gap is within the margin (they meet: true), the step is over or nothing is left within the
-// remaining look-ahead (they do not: false). Leaves s.points as they were on entry (the contacts now).
+// collision and Mirtich's thesis use it): the bodies move on at their current velocities by the largest
+// time their gap allows (the gap over a bound on how fast it can close: the relative velocity along the
+// closest normal, plus |ω| times each bounding radius), until the gap is within the margin (they meet:
+// true), the step is over, or nothing is left within the remaining look-ahead (they do not: false).
+// Leaves s.points as they were on entry (the contacts now).
 bool FclDetector::Impl::meets_within_step(const Placed& a, const Placed& b, const RigidBody& ra, const RigidBody& rb,
                                           BodyIndex ia, BodyIndex ib, double dt, double closing) {
   const double margin = settings.margin;

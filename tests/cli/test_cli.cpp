@@ -4,6 +4,8 @@
 #include <nlohmann/json.hpp>
 #include <Eigen/Core>
 
+#include "impetus_test/process.hpp"
+
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -21,23 +23,9 @@ namespace {
 
 namespace fs = std::filesystem;
 
-struct Result {
-  int status = -1;
-  std::string out;  // stdout and stderr together
-};
+using Result = impetus::test::CommandResult;
 
-Result run(const std::string& args) {
-  const std::string command = std::string(IMPETUS_EXE) + " " + args + " 2>&1";
-  Result r;
-  FILE* pipe = popen(command.c_str(), "r");
-  if (!pipe) return r;
-  char buffer[4096];
-  size_t n;
-  while ((n = fread(buffer, 1, sizeof buffer, pipe)) > 0) r.out.append(buffer, n);
-  const int raw = pclose(pipe);
-  r.status = WIFEXITED(raw) ? WEXITSTATUS(raw) : -1;
-  return r;
-}
+Result run(const std::string& args) { return impetus::test::run_shell(std::string(IMPETUS_EXE) + " " + args); }
 
 std::string scene(const char* name) { return std::string(IMPETUS_CLI_SCENES) + "/" + name; }
 

@@ -7,10 +7,10 @@
 #include <nlohmann/json.hpp>
 #include <tiny_gltf.h>
 
-#include <sys/wait.h>
+#include "impetus_test/process.hpp"
+
 #include <unistd.h>
 
-#include <cstdio>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -23,23 +23,9 @@ namespace {
 
 namespace fs = std::filesystem;
 
-struct Result {
-  int status = -1;
-  std::string out;
-};
+using Result = impetus::test::CommandResult;
 
-Result run(const std::string& args) {
-  const std::string command = args + " 2>&1";
-  Result r;
-  FILE* pipe = popen(command.c_str(), "r");
-  if (!pipe) return r;
-  char buffer[4096];
-  size_t n;
-  while ((n = fread(buffer, 1, sizeof buffer, pipe)) > 0) r.out.append(buffer, n);
-  const int raw = pclose(pipe);
-  r.status = WIFEXITED(raw) ? WEXITSTATUS(raw) : -1;
-  return r;
-}
+Result run(const std::string& command) { return impetus::test::run_shell(command); }
 
 fs::path temp_file(const std::string& name) {
   const fs::path dir = fs::temp_directory_path() / ("impetus_gltf_test_" + std::to_string(::getpid()));
