@@ -15,6 +15,8 @@
 
 #include <unistd.h>
 
+#include <algorithm>
+#include <cctype>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -143,6 +145,24 @@ struct RunOutputs {
   }
 };
 
+// What a run's output file may be called: --out FILE.csv (trajectory), FILE.glb or FILE.gltf (glTF 2.0);
+// --contacts FILE.csv. A device or a pipe (/dev/stdout, even redirected to a file) takes CSV whatever its
+// name. Anything
+// else is refused rather than guessed (README.md, "The `impetus` tool").
+void check_extension(const std::string& option, const std::filesystem::path& file) {
+  std::error_code ec;
+  if (file.string().starts_with("/dev/") ||
+      (std::filesystem::exists(file, ec) && !std::filesystem::is_regular_file(file, ec)))
+    return;
+  std::string ext = file.extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
+  if (option == "--out" && ext != ".csv" && ext != ".glb" && ext != ".gltf")
+    throw Error("--out " + file.string() + ": unknown extension '" + ext +
+                "'; use .csv (the trajectory as a table), .glb or .gltf (a glTF 2.0 animation)");
+  if (option == "--contacts" && ext != ".csv")
+    throw Error("--contacts " + file.string() + ": unknown extension '" + ext + "'; the contact log is written as .csv");
+}
+
 // Checks every output path before any file is created, so a bad --contacts leaves no empty --out behind,
 // and refuses two outputs naming one file.
 void check_outputs(const RunOutputs& outputs, const std::filesystem::path& scene) {
@@ -154,6 +174,7 @@ void check_outputs(const RunOutputs& outputs, const std::filesystem::path& scene
   if (!outputs.contacts.empty()) files.emplace_back("--contacts", outputs.contacts);
   for (std::size_t i = 0; i < files.size(); ++i) {
     cli::check_output_path(files[i].second, outputs.overwrite, scene, files[i].first);
+    check_extension(files[i].first, files[i].second);
     for (std::size_t j = 0; j < i; ++j)
       if (std::filesystem::weakly_canonical(files[i].second) == std::filesystem::weakly_canonical(files[j].second))
         throw Error(files[i].first + " " + files[i].second.string() + ": is also the file of " + files[j].first +

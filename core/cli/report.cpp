@@ -375,7 +375,12 @@ void check_output_path(const std::filesystem::path& out, bool overwrite, const s
   if (fs::is_symlink(fs::symlink_status(out, ec)) && !fs::exists(out, ec))
     throw Error(name + ": is a symbolic link to '" + fs::read_symlink(out, ec).string() +
                 "', which does not exist; Impetus does not create files through a dangling link");
-  if (!fs::exists(out, ec)) return;
+  if (!fs::exists(out, ec)) {
+    const fs::path folder = out.parent_path();
+    if (!folder.empty() && !fs::is_directory(folder, ec))
+      throw Error(name + ": the folder '" + folder.string() + "' does not exist (Impetus creates files, not folders)");
+    return;
+  }
   if (fs::is_directory(out, ec)) throw Error(name + ": is a directory");
   if (!input.empty() && fs::equivalent(out, input, ec))
     throw Error(name + ": is the scene being read; an input is never overwritten by an output");

@@ -81,7 +81,8 @@ void print_summary(const nlohmann::json& summary, std::ostream& out);
 
 /// Refuses an output path that would lose data or hurt an input, naming `option` (e.g. "--out"): an
 /// existing file without `overwrite`, a directory, a symbolic link to nothing (it would create a file
-/// elsewhere), or the same file as `input` (the scene being read), even with `overwrite`.
+/// elsewhere), the same file as `input` (the scene being read), even with `overwrite`, or a new file in a
+/// folder that does not exist.
 void check_output_path(const std::filesystem::path& out, bool overwrite, const std::filesystem::path& input,
                        const std::string& option);
 

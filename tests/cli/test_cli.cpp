@@ -269,6 +269,27 @@ TEST(Cli, ContactLogAndBodyTable) {
   EXPECT_NE(full.out.find("/dev/full: writing failed"), std::string::npos) << full.out;
 }
 
+// Output names the tool would have to guess at are refused before the run, naming the option and what
+// it accepts; a new file in a folder that does not exist names the folder; a device takes CSV whatever
+// its name (/dev/stdout prints the trajectory).
+TEST(Cli, OutputNamesAreCheckedBeforeTheRun) {
+  const Result txt = run("run --steps 5 --out " + temp_file("run.txt").string());
+  EXPECT_NE(txt.status, 0);
+  EXPECT_NE(txt.out.find("unknown extension '.txt'; use .csv"), std::string::npos) << txt.out;
+  EXPECT_FALSE(fs::exists(temp_file("run.txt")));
+  const Result log = run("run --steps 5 --contacts " + temp_file("log.json").string());
+  EXPECT_NE(log.out.find("--contacts " + temp_file("log.json").string() + ": unknown extension"), std::string::npos)
+      << log.out;
+  const fs::path nowhere = temp_file("no_such_folder") / "run.csv";
+  const Result missing = run("run --steps 5 --out " + nowhere.string());
+  EXPECT_NE(missing.status, 0);
+  EXPECT_NE(missing.out.find("does not exist"), std::string::npos) << missing.out;
+  EXPECT_NE(missing.out.find("no_such_folder"), std::string::npos) << missing.out;
+  const Result out = run("run --steps 2 --out /dev/stdout --overwrite");
+  EXPECT_EQ(out.status, 0) << out.out;
+  EXPECT_NE(out.out.find("step,time,body,x,y,z"), std::string::npos) << out.out;
+}
+
 // A body name with a comma or a quote is one CSV field (RFC 4180 quoting); the row keeps 16 fields.
 TEST(Cli, NamesWithCommasAreQuotedInTheTrajectory) {
   const fs::path f = temp_file("quoted.csv");
