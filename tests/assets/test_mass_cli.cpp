@@ -3,11 +3,10 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
-#include <sys/wait.h>
+#include "impetus_test/process.hpp"
 
 #include <algorithm>
 #include <cmath>
-#include <cstdio>
 #include <string>
 #include <utility>
 #include <vector>
@@ -21,20 +20,10 @@ struct Result {
 };
 
 Result run(const std::string& args) {
-  Result r;
-  for (const bool with_errors : {false, true}) {
-    const std::string command = std::string(IMPETUS_EXE) + " " + args + (with_errors ? " 2>&1" : " 2>/dev/null");
-    FILE* pipe = popen(command.c_str(), "r");
-    if (!pipe) return r;
-    std::string text;
-    char buffer[4096];
-    std::size_t n;
-    while ((n = fread(buffer, 1, sizeof buffer, pipe)) > 0) text.append(buffer, n);
-    const int raw = pclose(pipe);
-    r.status = WIFEXITED(raw) ? WEXITSTATUS(raw) : -1;
-    (with_errors ? r.all : r.out) = text;
-  }
-  return r;
+  const std::string command = std::string(IMPETUS_EXE) + " " + args;
+  const impetus::test::CommandResult quiet = impetus::test::run_shell(command, "/dev/null");
+  const impetus::test::CommandResult all = impetus::test::run_shell(command);
+  return {all.status, quiet.out, all.out};
 }
 
 std::string mesh(const std::string& name) { return std::string(IMPETUS_SOURCE_DIR) + "/assets/meshes/" + name; }

@@ -2,13 +2,15 @@
 // the resolver swapped on the command line.
 #include "scenario_support.hpp"
 
+#include "impetus_test/process.hpp"
+
 #include <nlohmann/json.hpp>
 
-#include <sys/wait.h>
 #include <unistd.h>
 
 #include <cmath>
-#include <cstdio>
+#include <fstream>
+#include <iterator>
 
 namespace impetus::scenario {
 namespace {
@@ -23,19 +25,11 @@ struct Result {
 Result run_impetus(const std::string& args) {
   const std::filesystem::path err_file =
       std::filesystem::temp_directory_path() / ("impetus_scenario_cli_" + std::to_string(::getpid()) + ".err");
-  const std::string command = std::string(IMPETUS_EXE) + " " + args + " 2>" + err_file.string();
-  Result r;
-  FILE* pipe = popen(command.c_str(), "r");
-  if (!pipe) return r;
-  char buffer[4096];
-  std::size_t n;
-  while ((n = fread(buffer, 1, sizeof buffer, pipe)) > 0) r.out.append(buffer, n);
-  const int raw = pclose(pipe);
-  r.status = WIFEXITED(raw) ? WEXITSTATUS(raw) : -1;
-  if (FILE* f = std::fopen(err_file.c_str(), "r")) {
-    while ((n = fread(buffer, 1, sizeof buffer, f)) > 0) r.err.append(buffer, n);
-    std::fclose(f);
-  }
+  const impetus::test::CommandResult run = impetus::test::run_shell(std::string(IMPETUS_EXE) + " " + args, err_file.string());
+  Result r{run.status, run.out, ""};
+  std::ifstream err(err_file);
+  r.err.assign(std::istreambuf_iterator<char>(err), std::istreambuf_iterator<char>());
+  err.close();
   std::filesystem::remove(err_file);
   return r;
 }
