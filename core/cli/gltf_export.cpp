@@ -215,9 +215,14 @@ tinygltf::Value text(const std::string& s) { return tinygltf::Value(s); }
 
 }  // namespace
 
-bool is_gltf_path(const std::filesystem::path& file) {
+std::string lowercase_extension(const std::filesystem::path& file) {
   std::string ext = file.extension().string();
   std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
+  return ext;
+}
+
+bool is_gltf_path(const std::filesystem::path& file) {
+  const std::string ext = lowercase_extension(file);
   return ext == ".glb" || ext == ".gltf";
 }
 
@@ -361,7 +366,7 @@ void GltfRecorder::finish(const World& world) {
       {"dt", tinygltf::Value(world.settings().dt)}});
   model.buffers[0].data.resize((model.buffers[0].data.size() + 3) / 4 * 4, 0);
 
-  const bool binary = file_.extension() == ".glb" || file_.extension() == ".GLB";
+  const bool binary = lowercase_extension(file_) == ".glb";
   std::ostringstream bytes;
   tinygltf::TinyGLTF writer;
   if (!writer.WriteGltfSceneToStream(&model, bytes, /*prettyPrint=*/!binary, binary))

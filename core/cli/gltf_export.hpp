@@ -15,7 +15,10 @@
 
 namespace impetus::cli {
 
-/// Whether `file` names a glTF output (`.glb` binary, `.gltf` JSON with an embedded buffer).
+/// The extension of `file` in lower case (".glb", ".csv", "" …).
+std::string lowercase_extension(const std::filesystem::path& file);
+
+/// Whether `file` names a glTF output (`.glb` binary, `.gltf` JSON with an embedded buffer), in any case.
 bool is_gltf_path(const std::filesystem::path& file);
 
 /// What the file's `extras` say about the run.

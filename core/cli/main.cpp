@@ -15,8 +15,6 @@
 
 #include <unistd.h>
 
-#include <algorithm>
-#include <cctype>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -135,9 +133,9 @@ struct RunOutputs {
   bool overwrite = false;
   std::uint64_t every = 1;
 
-  // The body table goes beside a trajectory written to a file, not beside a device or a pipe
-  // (/dev/stdout, /dev/full).
   bool gltf() const { return !trajectory.empty() && cli::is_gltf_path(trajectory); }
+  // The body table goes beside a CSV trajectory written to a file, not beside a device or a pipe
+  // (/dev/stdout, /dev/full).
   bool body_table() const {
     std::error_code ec;
     return !trajectory.empty() && !gltf() &&
@@ -147,15 +145,13 @@ struct RunOutputs {
 
 // What a run's output file may be called: --out FILE.csv (trajectory), FILE.glb or FILE.gltf (glTF 2.0);
 // --contacts FILE.csv. A device or a pipe (/dev/stdout, even redirected to a file) takes CSV whatever its
-// name. Anything
-// else is refused rather than guessed (README.md, "The `impetus` tool").
+// name. Anything else is refused rather than guessed (README.md, "The `impetus` tool").
 void check_extension(const std::string& option, const std::filesystem::path& file) {
   std::error_code ec;
   if (file.string().starts_with("/dev/") ||
       (std::filesystem::exists(file, ec) && !std::filesystem::is_regular_file(file, ec)))
     return;
-  std::string ext = file.extension().string();
-  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
+  const std::string ext = cli::lowercase_extension(file);
   if (option == "--out" && ext != ".csv" && ext != ".glb" && ext != ".gltf")
     throw Error("--out " + file.string() + ": unknown extension '" + ext +
                 "'; use .csv (the trajectory as a table), .glb or .gltf (a glTF 2.0 animation)");
