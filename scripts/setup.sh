@@ -16,6 +16,8 @@ packages=(
   clang libclang-rt-dev
   # glTF 2.0 export of runs (core/cli/gltf_export.cpp)
   libtinygltf-dev
+  # the viewer page's test in a headless browser, screenshots read back (tests/cli/test_viewer.cpp)
+  chromium libpng-dev
 )
 
 as_root=()
@@ -27,11 +29,13 @@ export DEBIAN_FRONTEND=noninteractive
 "${as_root[@]}" apt-get update
 "${as_root[@]}" apt-get install -y --no-install-recommends "${packages[@]}"
 
-# The Khronos glTF-Validator (npm, pinned in tests/gltf/package-lock.json) for the glTF export tests, with
-# the machine's Node.js and npm.
-root=$(cd "$(dirname "$0")/.." && pwd)
-if command -v npm >/dev/null && command -v node >/dev/null; then
-  npm ci --prefix "$root/tests/gltf" --no-audit --no-fund --loglevel=error
-else
-  echo "setup.sh: Node.js and npm not found: the glTF validation test (tests/cli/test_gltf.cpp) will fail" >&2
+# Node.js and npm from Debian unless the machine has them already (a newer Node.js from elsewhere stays).
+if ! command -v node >/dev/null || ! command -v npm >/dev/null; then
+  "${as_root[@]}" apt-get install -y --no-install-recommends nodejs npm
 fi
+
+# npm packages, pinned by their package-lock.json: three.js and esbuild for the viewer page
+# (core/cli/viewer, bundled into the tool by the build), the Khronos glTF-Validator for the glTF tests.
+root=$(cd "$(dirname "$0")/.." && pwd)
+npm ci --prefix "$root/core/cli/viewer" --no-audit --no-fund --loglevel=error
+npm ci --prefix "$root/tests/gltf" --no-audit --no-fund --loglevel=error

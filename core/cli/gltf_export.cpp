@@ -1,9 +1,11 @@
 #include "gltf_export.hpp"
 
 #include "report.hpp"
+#include "viewer_page.hpp"
 
 #include "impetus/core/error.hpp"
 #include "impetus/core/format.hpp"
+#include "impetus/engine/metrics.hpp"
 
 #include <tiny_gltf.h>
 
@@ -11,7 +13,9 @@
 #include <cmath>
 #include <cstring>
 #include <fstream>
+#include <iostream>
 #include <numbers>
+#include <span>
 #include <sstream>
 #include <type_traits>
 #include <variant>
@@ -221,39 +225,82 @@ std::string lowercase_extension(const std::filesystem::path& file) {
   return ext;
 }
 
-bool is_gltf_path(const std::filesystem::path& file) {
+bool is_animation_path(const std::filesystem::path& file) {
   const std::string ext = lowercase_extension(file);
-  return ext == ".glb" || ext == ".gltf";
+  return ext == ".glb" || ext == ".gltf" || ext == ".html";
 }
+
+namespace {
+
+// Bytes a sample holds: its time and three series, and per moving body a translation, a rotation, a
+// velocity and an angular velocity (float32).
+constexpr double kSampleBytes = 16.0, kBodySampleBytes = 52.0, kContactBytes = 36.0;
+
+}  // namespace
 
 GltfRecorder::GltfRecorder(const std::filesystem::path& file, bool overwrite, const std::filesystem::path& input,
                            const World& world, std::uint64_t samples, GltfRunInfo info)
     : file_(file), info_(std::move(info)) {
   check_output_path(file, overwrite, input, "--out");
+  if (lowercase_extension(file) == ".html") check_viewer_available("--out " + file.string());
   std::uint64_t moving = 0;
   for (const RigidBody& b : world.bodies()) moving += moves(b) ? 1 : 0;
-  const double bytes = static_cast<double>(samples) * (4.0 + 28.0 * static_cast<double>(moving));
+  const double bytes = static_cast<double>(samples) * (kSampleBytes + kBodySampleBytes * static_cast<double>(moving));
   if (bytes > static_cast<double>(kMaxAnimationBytes))
     throw Error("--out " + file.string() + ": the animation would hold " + std::to_string(samples) + " samples of " +
                 std::to_string(moving) + " moving bodies (" + format_number(std::round(bytes / 1e6)) +
                 " MB), more than the " + std::to_string(kMaxAnimationBytes >> 20) +
                 " MiB a glTF export keeps in memory; record fewer steps with --every");
+  bytes_ = static_cast<std::uint64_t>(bytes);
   translations_.resize(world.bodies().size());
   rotations_.resize(world.bodies().size());
+  velocities_.resize(world.bodies().size());
+  angular_velocities_.resize(world.bodies().size());
 }
 
 void GltfRecorder::record(const World& world) {
-  times_.push_back(static_cast<float>(world.time()));
   const auto bodies = world.bodies();
+  times_.push_back(static_cast<float>(world.time()));
+  kinetic_.push_back(static_cast<float>(total_kinetic_energy(bodies)));
+  potential_.push_back(static_cast<float>(load_potential_energy(bodies, world.settings().gravity)));
+  double deepest = 0.0;
+  for (const Contact& c : world.contacts()) deepest = std::max(deepest, c.depth);
+  penetration_.push_back(static_cast<float>(deepest));
+  const auto push3 = [](std::vector<float>& to, const Vec3& v) {
+    for (int k = 0; k < 3; ++k) to.push_back(static_cast<float>(v[k]));
+  };
   for (std::size_t i = 0; i < bodies.size(); ++i) {
     if (!moves(bodies[i])) continue;
     const Quat q = bodies[i].orientation();
-    for (int k = 0; k < 3; ++k) translations_[i].push_back(static_cast<float>(bodies[i].position[k]));
+    push3(translations_[i], bodies[i].position);
     for (const double c : {q.x(), q.y(), q.z(), q.w()}) rotations_[i].push_back(static_cast<float>(c));
+    push3(velocities_[i], bodies[i].velocity);
+    push3(angular_velocities_[i], bodies[i].angular_velocity);
+  }
+  // Contacts are what a run cannot bound in advance: once they would pass the cap, the rest of the run
+  // records none, and the file says so (extras "contacts_complete": false).
+  const std::span<const Contact> contacts = world.contacts();
+  const std::uint64_t more = static_cast<std::uint64_t>(kContactBytes) * contacts.size();
+  if (contacts_complete_ && bytes_ + more > kMaxAnimationBytes) {
+    contacts_complete_ = false;
+    std::cerr << "impetus: warning: --out " << file_.string() << ": contacts are not recorded after t = "
+              << format_number(world.time()) << " s: they would pass the " << (kMaxAnimationBytes >> 20)
+              << " MiB a glTF export keeps in memory (record fewer steps with --every)\n";
+  }
+  if (!contacts_complete_) {
+    contact_counts_.push_back(0);
+    return;
+  }
+  bytes_ += more;
+  contact_counts_.push_back(static_cast<std::uint32_t>(contacts.size()));
+  for (const Contact& c : contacts) {
+    push3(contact_points_, c.point);
+    push3(normal_impulses_, c.impulse * c.normal);
+    push3(tangent_impulses_, c.tangent_impulse);
   }
 }
 
-void GltfRecorder::finish(const World& world) {
+std::string GltfRecorder::serialize(const World& world, bool binary) const {
   const auto bodies = world.bodies();
   tinygltf::Model model;
   model.asset.version = "2.0";
@@ -320,6 +367,11 @@ void GltfRecorder::finish(const World& world) {
                                    {"mass", tinygltf::Value(b.fixed ? 0.0 : b.mass)},
                                    {"fixed", tinygltf::Value(b.fixed)},
                                    {"shape", text(shape_kind_name(b.shape))}};
+    if (!velocities_[i].empty()) {
+      extras["velocity"] = tinygltf::Value(add_floats(model, velocities_[i], TINYGLTF_TYPE_VEC3, 3, 0, false));
+      extras["angular_velocity"] =
+          tinygltf::Value(add_floats(model, angular_velocities_[i], TINYGLTF_TYPE_VEC3, 3, 0, false));
+    }
     node.extras = tinygltf::Value(extras);
     model.nodes.push_back(node);
     scene.nodes.push_back(static_cast<int>(model.nodes.size() - 1));
@@ -331,10 +383,11 @@ void GltfRecorder::finish(const World& world) {
   model.defaultScene = 0;
 
   // One animation: every recorded time, and per moving body a translation and a rotation sampler.
+  // The sample times: the animation's input, and the time axis of the series in extras.
+  const int input = times_.empty() ? -1 : add_floats(model, times_, TINYGLTF_TYPE_SCALAR, 1, 0, true);
   if (!times_.empty()) {
     tinygltf::Animation animation;
     animation.name = "trajectory";
-    const int input = add_floats(model, times_, TINYGLTF_TYPE_SCALAR, 1, 0, true);
     for (std::size_t i = 0; i < bodies.size(); ++i) {
       if (!moves(bodies[i])) continue;
       const std::pair<const std::vector<float>*, const char*> paths[] = {{&translations_[i], "translation"},
@@ -356,6 +409,31 @@ void GltfRecorder::finish(const World& world) {
     if (!animation.channels.empty()) model.animations.push_back(animation);
   }
 
+  // What the viewer page plots and draws besides the motion: one value per sample, and the contacts of every
+  // sample one after another (`contact_counts` says how many each has).
+  const auto scalars = [&](const std::vector<float>& values) {
+    return tinygltf::Value(add_floats(model, values, TINYGLTF_TYPE_SCALAR, 1, 0, false));
+  };
+  tinygltf::Value::Object contacts{{"complete", tinygltf::Value(contacts_complete_)}};
+  if (!contact_counts_.empty()) {
+    std::vector<float> counts(contact_counts_.begin(), contact_counts_.end());
+    contacts["counts"] = scalars(counts);
+  }
+  if (!contact_points_.empty()) {
+    const auto vectors = [&](const std::vector<float>& values) {
+      return tinygltf::Value(add_floats(model, values, TINYGLTF_TYPE_VEC3, 3, 0, false));
+    };
+    contacts["points"] = vectors(contact_points_);
+    contacts["normal_impulses"] = vectors(normal_impulses_);
+    contacts["tangent_impulses"] = vectors(tangent_impulses_);
+  }
+  tinygltf::Value::Object series;
+  if (!times_.empty())
+    series = {{"times", tinygltf::Value(input)},
+              {"kinetic_energy", scalars(kinetic_)},
+              {"potential_energy", scalars(potential_)},
+              {"penetration", scalars(penetration_)}};
+  const Vec3& g = world.settings().gravity;
   model.asset.extras = tinygltf::Value(tinygltf::Value::Object{
       {"impetus_scene", text(info_.scene_file)},
       {"modules", tinygltf::Value(tinygltf::Value::Object{{"integrator", text(info_.integrator)},
@@ -363,21 +441,25 @@ void GltfRecorder::finish(const World& world) {
                                                           {"resolver", text(info_.resolver)}})},
       {"bodies", tinygltf::Value(names)},
       {"masses", tinygltf::Value(masses)},
-      {"dt", tinygltf::Value(world.settings().dt)}});
+      {"dt", tinygltf::Value(world.settings().dt)},
+      {"gravity", tinygltf::Value(tinygltf::Value::Array{tinygltf::Value(g.x()), tinygltf::Value(g.y()),
+                                                         tinygltf::Value(g.z())})},
+      {"series", tinygltf::Value(series)},
+      {"contacts", tinygltf::Value(contacts)}});
   model.buffers[0].data.resize((model.buffers[0].data.size() + 3) / 4 * 4, 0);
 
-  const bool binary = lowercase_extension(file_) == ".glb";
   std::ostringstream bytes;
   tinygltf::TinyGLTF writer;
   if (!writer.WriteGltfSceneToStream(&model, bytes, /*prettyPrint=*/!binary, binary))
     throw Error(file_.string() + ": the glTF document could not be serialized");
-  std::ofstream out(file_, std::ios::binary | std::ios::trunc);
-  if (!out) throw Error(file_.string() + ": cannot open for writing");
-  const std::string data = bytes.str();
-  out.write(data.data(), static_cast<std::streamsize>(data.size()));
-  out.flush();
-  out.close();
-  if (!out) throw Error(file_.string() + ": writing failed (the device is full or the file cannot be written)");
+  return bytes.str();
+}
+
+void GltfRecorder::finish(const World& world) {
+  const std::string ext = lowercase_extension(file_);
+  const std::string data = ext == ".html" ? viewer_page(serialize(world, true), info_.scene_file)
+                                          : serialize(world, ext == ".glb");
+  write_file(file_, data);
 }
 
 }  // namespace impetus::cli

@@ -5,6 +5,7 @@
 #include "gltf_export.hpp"
 #include "mass_command.hpp"
 #include "report.hpp"
+#include "viewer_page.hpp"
 
 #include "impetus/core/error.hpp"
 #include "impetus/core/format.hpp"
@@ -133,18 +134,18 @@ struct RunOutputs {
   bool overwrite = false;
   std::uint64_t every = 1;
 
-  bool gltf() const { return !trajectory.empty() && cli::is_gltf_path(trajectory); }
+  bool animation() const { return !trajectory.empty() && cli::is_animation_path(trajectory); }
   // The body table goes beside a CSV trajectory written to a file, not beside a device or a pipe
   // (/dev/stdout, /dev/full).
   bool body_table() const {
     std::error_code ec;
-    return !trajectory.empty() && !gltf() &&
+    return !trajectory.empty() && !animation() &&
            (!std::filesystem::exists(trajectory, ec) || std::filesystem::is_regular_file(trajectory, ec));
   }
 };
 
-// What a run's output file may be called: --out FILE.csv (trajectory), FILE.glb or FILE.gltf (glTF 2.0);
-// --contacts FILE.csv. A device or a pipe (/dev/stdout, even redirected to a file) takes CSV whatever its
+// What a run's output file may be called: --out FILE.csv (trajectory), FILE.glb or FILE.gltf (glTF 2.0),
+// FILE.html (the viewer page); --contacts FILE.csv. A device or a pipe (/dev/stdout, even redirected to a file) takes CSV whatever its
 // name. Anything else is refused rather than guessed (README.md, "The `impetus` tool").
 void check_extension(const std::string& option, const std::filesystem::path& file) {
   std::error_code ec;
@@ -152,9 +153,10 @@ void check_extension(const std::string& option, const std::filesystem::path& fil
       (std::filesystem::exists(file, ec) && !std::filesystem::is_regular_file(file, ec)))
     return;
   const std::string ext = cli::lowercase_extension(file);
-  if (option == "--out" && ext != ".csv" && ext != ".glb" && ext != ".gltf")
+  if (option == "--out" && ext != ".csv" && !cli::is_animation_path(file))
     throw Error("--out " + file.string() + ": unknown extension '" + ext +
-                "'; use .csv (the trajectory as a table), .glb or .gltf (a glTF 2.0 animation)");
+                "'; use .csv (the trajectory as a table), .glb or .gltf (a glTF 2.0 animation) or .html (the "
+                "viewer page)");
   if (option == "--contacts" && ext != ".csv")
     throw Error("--contacts " + file.string() + ": unknown extension '" + ext + "'; the contact log is written as .csv");
 }
@@ -203,7 +205,7 @@ int run_command(const SceneArgs& args, std::optional<std::uint64_t> steps, std::
   check_outputs(outputs, scene.file);
   std::optional<cli::TrajectoryWriter> writer;
   std::optional<cli::GltfRecorder> animation;
-  if (outputs.gltf()) {
+  if (outputs.animation()) {
     animation.emplace(outputs.trajectory, outputs.overwrite, scene.file, *world, total / outputs.every + 2,
                       cli::GltfRunInfo{scene.file.string(), scene.integrator.plugin, scene.detector.plugin,
                                        scene.resolver.plugin, IMPETUS_VERSION});
@@ -262,6 +264,9 @@ int run_command(const SceneArgs& args, std::optional<std::uint64_t> steps, std::
     if (!outputs.trajectory.empty()) {
       std::cout << "trajectory            " << outputs.trajectory;
       if (outputs.body_table()) std::cout << " (bodies: " << cli::body_table_path(outputs.trajectory).string() << ")";
+      if (cli::lowercase_extension(outputs.trajectory) == ".html")
+        std::cout << "  (open it in a browser: file://"
+                  << fs::absolute(outputs.trajectory).lexically_normal().string() << ")";
       std::cout << "\n";
     }
     if (!outputs.contacts.empty()) std::cout << "contact log           " << outputs.contacts << "\n";
@@ -322,7 +327,7 @@ int main(int argc, char** argv) {
   run->add_option("--out", outputs.trajectory,
                   "write the trajectory as CSV: step,time,body,x,y,z,qw,qx,qy,qz,vx,vy,vz,wx,wy,wz, and the bodies "
                   "(name, mass, shape, sizes) beside it as FILE.bodies.csv; or, for FILE.glb / FILE.gltf, as a glTF "
-                  "2.0 animation of the bodies' shapes");
+                  "2.0 animation of the bodies' shapes; or, for FILE.html, as a page that plays it in a browser");
   run->add_option("--contacts", outputs.contacts,
                   "write the contact log as CSV: step,time,a,b,x,y,z,nx,ny,nz,depth,impulse,tx,ty,tz,mode");
   run->add_flag("--overwrite", outputs.overwrite, "allow --out and --contacts to replace existing files");
@@ -358,6 +363,14 @@ int main(int argc, char** argv) {
   fclib_export->add_flag("--global", fclib_export_args.global, "write the global form (M, H, f, w) instead of the local one (W, q)");
   fclib_export->add_flag("--overwrite", fclib_export_args.overwrite, "allow --out to replace an existing file");
 
+  cli::ViewArgs view_args;
+  auto* view = app.add_subcommand("view", "write a page that plays a run exported as glTF in a browser, offline");
+  view->add_option("file", view_args.file, "a run exported by impetus run --out FILE.glb (or .gltf)")
+      ->required()
+      ->check(CLI::ExistingFile);
+  view->add_option("--out", view_args.out, "the HTML page to write")->required();
+  view->add_flag("--overwrite", view_args.overwrite, "allow --out to replace an existing file");
+
   cli::MassArgs mass_args;
   auto* mass = cli::add_mass_command(app, mass_args);
 
@@ -371,6 +384,7 @@ int main(int argc, char** argv) {
     if (run->parsed()) return run_command(run_args, steps, duration, outputs, run_json);
     if (resolve->parsed()) return resolve_command(resolve_args, resolve_json);
     if (mass->parsed()) return cli::run_mass_command(mass_args);
+    if (view->parsed()) return cli::run_view_command(view_args);
     if (fclib_solve->parsed()) return cli::run_fclib_solve(fclib_solve_args);
     if (fclib_export->parsed()) return fclib_export_command(fclib_export_scene, fclib_export_args);
     if (plugins->parsed()) {

@@ -387,6 +387,15 @@ void check_output_path(const std::filesystem::path& out, bool overwrite, const s
   if (!overwrite) throw Error(name + ": file exists; pass --overwrite to replace it");
 }
 
+void write_file(const std::filesystem::path& file, std::string_view data) {
+  std::ofstream out(file, std::ios::binary | std::ios::trunc);
+  if (!out) throw Error(file.string() + ": cannot open for writing");
+  out.write(data.data(), static_cast<std::streamsize>(data.size()));
+  out.flush();
+  out.close();
+  if (!out) throw Error(file.string() + ": writing failed (the device is full or the file cannot be written)");
+}
+
 CsvFile::CsvFile(const std::filesystem::path& file, bool overwrite, const std::filesystem::path& input,
                  const std::string& option, const std::string& header)
     : file_(file) {

@@ -12,6 +12,7 @@
 #include <filesystem>
 #include <fstream>
 #include <string>
+#include <string_view>
 #include <vector>
 
 namespace impetus::cli {
@@ -85,6 +86,10 @@ void print_summary(const nlohmann::json& summary, std::ostream& out);
 /// folder that does not exist.
 void check_output_path(const std::filesystem::path& out, bool overwrite, const std::filesystem::path& input,
                        const std::string& option);
+
+/// Writes `data` to `file` (replacing it; the path was checked before), throwing Error if it could not be
+/// written whole (a full disk, /dev/full).
+void write_file(const std::filesystem::path& file, std::string_view data);
 
 /// A CSV file the tool writes: its path is checked first (check_output_path, naming `option`), every
 /// write is checked, and finish() checks the final flush, so a full disk is an error, never a short file.
