@@ -307,6 +307,21 @@ TEST(CliViewer, ChromiumDrawsTheBallWhereItsPoseSays) {
   EXPECT_NEAR(status["time"].get<double>(), rows[early].time, 1e-12);
   EXPECT_EQ(status["fov"], 45);
 
+  // A body picked (as a click does): its state at that time is the run's, at float32.
+  const nlohmann::json picked = page_status(o.page, camera_hash(rows[early].time) + "&select=marker");
+  ASSERT_TRUE(picked["selected"].is_object()) << picked.dump();
+  EXPECT_EQ(picked["selected"]["name"], "marker");
+  EXPECT_EQ(picked["selected"]["mass"], kMass);
+  for (int k = 0; k < 3; ++k) {
+    EXPECT_NEAR(picked["selected"]["velocity"][k].get<double>(), rows[early].velocity[k], 1e-6);
+    EXPECT_NEAR(picked["selected"]["position"][k].get<double>(), rows[early].position[k], 1e-6);
+  }
+  // Opened without a time, the page plays: at 4× the one-second run is over well within Chromium's
+  // (virtual) ten seconds, and it stops at the end.
+  const nlohmann::json played = page_status(o.page, "speed=4");
+  EXPECT_TRUE(played["errors"].empty()) << played["errors"].dump();
+  EXPECT_EQ(played["time"].get<double>(), played["duration"].get<double>()) << played.dump();
+
   // The ball's colour as the exporter gave it, seen through the page's sRGB output.
   tinygltf::TinyGLTF loader;
   tinygltf::Model model;

@@ -13,10 +13,11 @@ export function decodeBase64(text) {
 /**
  * Options a link can carry after '#', for a fixed view (tests, screenshots, a shared link):
  * time=T (start paused at T seconds), camera=px,py,pz,tx,ty,tz (eye and target, world metres),
- * contacts (draw contacts), speed=S. Anything else is ignored; a malformed value is an error.
+ * contacts (draw contacts), speed=S, select=NAME (show that body's information). Anything else is
+ * ignored; a malformed value is an error.
  */
 export function parseOptions(hash) {
-  const options = { time: null, camera: null, contacts: false, speed: 1 };
+  const options = { time: null, camera: null, contacts: false, speed: 1, select: null };
   const text = hash.startsWith('#') ? hash.slice(1) : hash;
   for (const part of text.split('&')) {
     if (!part) continue;
@@ -33,6 +34,8 @@ export function parseOptions(hash) {
       if (options.camera.length !== 6) throw new Error(`#camera=${value}: needs six numbers (eye and target)`);
     } else if (key === 'contacts') {
       options.contacts = value !== '0';
+    } else if (key === 'select') {
+      options.select = decodeURIComponent(value);
     } else if (key === 'speed') {
       [options.speed] = numbers();
       if (!(options.speed > 0)) throw new Error(`#speed=${value}: must be positive`);

@@ -214,9 +214,14 @@ function main(run, options) {
     if (state.selected) state.selected.object.traverse((o) => o.material?.emissive?.setHex(0x2a2a2a));
     $('info').style.display = state.selected ? 'block' : 'none';
   }
+  if (options.select !== null) {
+    const body = run.bodies.find((b) => b.name === options.select);
+    if (!body) throw new Error(`#select=${options.select}: no body of that name in this run`);
+    select(body);
+  }
   function showInfo() {
     const body = state.selected;
-    if (!body) return;
+    if (!body) return null;
     const rows = [['body', body.name], ['shape', body.shape],
                   ['mass', body.fixed ? 'fixed' : formatQuantity(body.mass, 'kg', 4)]];
     const p = body.object.position;
@@ -235,6 +240,12 @@ function main(run, options) {
       tr.insertCell().textContent = value;
     }
     $('info').replaceChildren(table);
+    return {
+      name: body.name,
+      mass: body.mass,
+      position: [p.x, p.y, p.z],
+      velocity: body.velocity ? interpolate(run.times, body.velocity, 3, state.time) : null,
+    };
   }
 
   // The plot and its legend.
@@ -309,9 +320,10 @@ function main(run, options) {
     $('clock').textContent = `t = ${state.time.toFixed(3)} s / ${duration.toFixed(3)} s`;
     $('scrubber').value = String(duration > 0 ? Math.round((state.time / duration) * 1000) : 0);
     if (curves && $('show-plot').checked) drawPlot($('plot'), run.times, curves, run.penetration, state.time);
-    showInfo();
+    selectedInfo = showInfo();
     report('ready');
   }
+  let selectedInfo = null;
   function report(phase) {
     $('impetus-status').textContent = JSON.stringify({
       state: phase,
@@ -322,6 +334,7 @@ function main(run, options) {
       samples: run.times.length,
       bodies: run.bodies.length,
       contacts_shown: contactsShown,
+      selected: selectedInfo,
       width: window.innerWidth,
       height: window.innerHeight,
       camera: [...camera.position.toArray(), ...controls.target.toArray()],

@@ -15,9 +15,9 @@ test('base64 decodes what Buffer encodes, whatever the padding', () => {
 });
 
 test('link options: time, camera, contacts, speed; malformed values are errors', () => {
-  assert.deepEqual(parseOptions(''), { time: null, camera: null, contacts: false, speed: 1 });
-  assert.deepEqual(parseOptions('#time=1.5&camera=0,-6,2,0,0,0.5&contacts&speed=2'),
-                   { time: 1.5, camera: [0, -6, 2, 0, 0, 0.5], contacts: true, speed: 2 });
+  assert.deepEqual(parseOptions(''), { time: null, camera: null, contacts: false, speed: 1, select: null });
+  assert.deepEqual(parseOptions('#time=1.5&camera=0,-6,2,0,0,0.5&contacts&speed=2&select=box%201'),
+                   { time: 1.5, camera: [0, -6, 2, 0, 0, 0.5], contacts: true, speed: 2, select: 'box 1' });
   assert.throws(() => parseOptions('#camera=1,2,3'), /six numbers/);
   assert.throws(() => parseOptions('#time=soon'), /not a list of numbers/);
   assert.throws(() => parseOptions('#speed=-1'), /positive/);
