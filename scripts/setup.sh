@@ -18,6 +18,8 @@ packages=(
   libtinygltf-dev
   # the viewer page's test in a headless browser, screenshots read back (tests/cli/test_viewer.cpp)
   chromium libpng-dev
+  # the Python package (python/): bindings, numpy state, its tests, sweeps on Dask
+  python3-dev pybind11-dev python3-numpy python3-pytest python3-distributed python3-yaml
 )
 
 as_root=()

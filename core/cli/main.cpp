@@ -118,15 +118,6 @@ class Progress {
   Clock::time_point start_ = Clock::now(), last_{};
 };
 
-// The options a scene or the command line gave a module (plugin defaults are not known here): a string
-// per scalar, an array of strings per list.
-nlohmann::json options_json(const ModuleOptions& options) {
-  nlohmann::json out = nlohmann::json::object();
-  for (const auto& [key, value] : options.values())
-    out[key] = value.is_list ? nlohmann::json(value.items) : nlohmann::json(value.text);
-  return out;
-}
-
 // What `run` writes besides its summary.
 struct RunOutputs {
   std::string trajectory;  // --out (and its body table beside it)
@@ -222,18 +213,11 @@ int run_command(const SceneArgs& args, std::optional<std::uint64_t> steps, std::
   Progress progress(total);
   const auto start = Clock::now();
   for (std::uint64_t i = 0; i < total; ++i) {
-    stats.before_step(*world);
-    const StepStatus& status = world->step();
-    if (!status.ok) {
+    try {
+      cli::checked_step(*world, stats, scene.file.string());
+    } catch (const Error&) {
       progress.done();
-      throw Error(scene.file.string() + ": " + status.message);
-    }
-    stats.add_step(*world, status);
-    if (const char* what = stats.non_finite()) {
-      progress.done();
-      throw Error(scene.file.string() + ": step " + std::to_string(world->step_count()) + " (t = " +
-                  format_number(world->time()) + " s): the run's " + what +
-                  " is no longer finite (velocities, masses or the time step too large to square)");
+      throw;
     }
     if (world->step_count() % outputs.every == 0 || i + 1 == total) {
       if (writer) writer->write(*world);
@@ -247,16 +231,7 @@ int run_command(const SceneArgs& args, std::optional<std::uint64_t> steps, std::
   if (animation) animation->finish(*world);
   if (contact_log) contact_log->finish();
   const double wall = std::chrono::duration<double>(Clock::now() - start).count();
-  nlohmann::json summary = stats.summary(*world, wall);
-  summary["scene"] = scene.file.string();
-  summary["modules"] = {{"integrator", scene.integrator.plugin},
-                        {"detector", scene.detector.plugin},
-                        {"resolver", scene.resolver.plugin}};
-  summary["module_options"] = {{"integrator", options_json(scene.integrator.options)},
-                               {"detector", options_json(scene.detector.options)},
-                               {"resolver", options_json(scene.resolver.options)}};
-  // Without a resolver the detector still runs (World::contacts() shows what it found): say so.
-  summary["contacts_per_step"]["resolved"] = world->has_resolver() || !world->has_detector();
+  const nlohmann::json summary = cli::run_summary(scene, *world, stats, wall);
   if (json) {
     std::cout << summary.dump(2) << "\n";
   } else {

@@ -15,8 +15,6 @@
 namespace impetus::cli {
 namespace {
 
-nlohmann::json vector_json(const Vec3& v) { return {v.x(), v.y(), v.z()}; }
-
 std::string text(double x) {
   char buffer[32];
   std::snprintf(buffer, sizeof buffer, "%.10g", x + 0.0);  // + 0.0: no "-0"
@@ -43,57 +41,15 @@ CLI::App* add_mass_command(CLI::App& app, MassArgs& args) {
   return cmd;
 }
 
-namespace {
-
-// A value that overflows, named as the option that gave it ("--scale 1e+70 is too large: …").
-[[noreturn]] void rethrow_as_option(const assets::MassOverflow& e) {
-  switch (e.cause()) {
-    case assets::MassOverflow::Cause::scale: throw Error(e.message_naming("--scale"));
-    case assets::MassOverflow::Cause::density: throw Error(e.message_naming("--density"));
-    case assets::MassOverflow::Cause::mass: throw Error(e.message_naming("--mass"));
-  }
-  throw Error(e.what());
-}
-
-}  // namespace
-
 int run_mass_command(const MassArgs& args) {
-  assets::ImportOptions options;
-  options.scale = args.scale;
-  assets::MeshBody body;
-  assets::MassProperties p;
-  const std::string label = args.mesh + (args.part.empty() ? "" : " (part '" + args.part + "')");
-  try {
-    body = assets::load_mesh_body(args.mesh, options, args.part);
-    p = assets::mesh_mass_properties(body, args.density, args.mass, label);
-  } catch (const assets::MassOverflow& e) {
-    rethrow_as_option(e);
-  }
+  const MassResult result = compute_mass(args);
+  const assets::MeshBody& body = result.body;
+  const assets::MassProperties& p = result.properties;
   const Vec3& com = body.center_of_mass_file;  // the body frame's origin, in file coordinates
-  // Nothing that is not a number is ever printed (the library refuses it; this is the last guard).
-  if (!(std::isfinite(p.volume) && std::isfinite(p.mass) && std::isfinite(p.density) && p.inertia.allFinite() &&
-        p.principal_moments.allFinite() && p.principal_axes.allFinite() && com.allFinite()))
-    throw Error(label + ": its mass properties are not finite numbers; nothing is printed");
   for (const std::string& w : body.warnings) std::cerr << "impetus: warning: " << w << "\n";
 
   if (args.json) {
-    nlohmann::json j;
-    j["file"] = args.mesh;
-    j["format"] = body.format;
-    if (!args.part.empty()) j["part"] = args.part;
-    j["scale"] = args.scale;
-    j["vertices"] = body.mesh->vertices.size();
-    j["triangles"] = body.mesh->triangles.size();
-    j["convex"] = body.convex;
-    j["volume"] = p.volume;
-    j["density"] = p.density;
-    j["mass"] = p.mass;
-    j["center_of_mass"] = vector_json(com);
-    j["inertia"] = {vector_json(p.inertia.row(0)), vector_json(p.inertia.row(1)), vector_json(p.inertia.row(2))};
-    j["principal_moments"] = vector_json(p.principal_moments);
-    j["principal_axes"] = {vector_json(p.principal_axes.col(0)), vector_json(p.principal_axes.col(1)),
-                           vector_json(p.principal_axes.col(2))};
-    j["warnings"] = body.warnings;
+    const nlohmann::json j = mass_json(args, result);
     std::cout << j.dump(2) << "\n";
     return 0;
   }

@@ -387,6 +387,38 @@ void check_output_path(const std::filesystem::path& out, bool overwrite, const s
   if (!overwrite) throw Error(name + ": file exists; pass --overwrite to replace it");
 }
 
+void checked_step(World& world, RunStats& stats, const std::string& scene_file) {
+  stats.before_step(world);
+  const StepStatus& status = world.step();
+  if (!status.ok) throw Error(scene_file + ": " + status.message);
+  stats.add_step(world, status);
+  if (const char* what = stats.non_finite())
+    throw Error(scene_file + ": step " + std::to_string(world.step_count()) + " (t = " + format_number(world.time()) +
+                " s): the run's " + what +
+                " is no longer finite (velocities, masses or the time step too large to square)");
+}
+
+nlohmann::json options_json(const ModuleOptions& options) {
+  nlohmann::json out = nlohmann::json::object();
+  for (const auto& [key, value] : options.values())
+    out[key] = value.is_list ? nlohmann::json(value.items) : nlohmann::json(value.text);
+  return out;
+}
+
+nlohmann::json run_summary(const Scene& scene, const World& world, const RunStats& stats, double wall_seconds) {
+  nlohmann::json summary = stats.summary(world, wall_seconds);
+  summary["scene"] = scene.file.string();
+  summary["modules"] = {{"integrator", scene.integrator.plugin},
+                        {"detector", scene.detector.plugin},
+                        {"resolver", scene.resolver.plugin}};
+  summary["module_options"] = {{"integrator", options_json(scene.integrator.options)},
+                               {"detector", options_json(scene.detector.options)},
+                               {"resolver", options_json(scene.resolver.options)}};
+  // Without a resolver the detector still runs (World::contacts() shows what it found): say so.
+  summary["contacts_per_step"]["resolved"] = world.has_resolver() || !world.has_detector();
+  return summary;
+}
+
 void write_file(const std::filesystem::path& file, std::string_view data) {
   std::ofstream out(file, std::ios::binary | std::ios::trunc);
   if (!out) throw Error(file.string() + ": cannot open for writing");

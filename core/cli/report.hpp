@@ -1,8 +1,10 @@
 #pragma once
 // Summaries and output files of the `impetus` tool: run statistics, the trajectory CSV, and the JSON
-// documents of `run --json`, `resolve --json` and `plugins --json`.
+// documents of `run --json`, `resolve --json` and `plugins --json`. Part of the tool's support library
+// (impetus_tool_support), which the Python package links too, so both report a run the same way.
 
 #include "impetus/engine/metrics.hpp"
+#include "impetus/engine/scene.hpp"
 #include "impetus/engine/world.hpp"
 #include "impetus/plugins/host.hpp"
 
@@ -76,6 +78,17 @@ class RunStats {
   double friction_work_ = 0.0, max_natural_map_ = 0.0;
   double max_penetration_ = 0.0, max_residual_ = 0.0;
 };
+
+/// One step of a run with its statistics: throws Error("<scene file>: …") when the step failed (the world
+/// is back at its state before it) or the run's accounting is no longer finite.
+void checked_step(World& world, RunStats& stats, const std::string& scene_file);
+
+/// The options a scene or an override gave a module (plugin defaults are not known here): a string per
+/// scalar, an array of strings per list.
+nlohmann::json options_json(const ModuleOptions& options);
+
+/// The `run --json` document: the statistics' summary with the scene, its modules and their options.
+nlohmann::json run_summary(const Scene& scene, const World& world, const RunStats& stats, double wall_seconds);
 
 /// Prints a run summary for people.
 void print_summary(const nlohmann::json& summary, std::ostream& out);
