@@ -251,21 +251,14 @@ int run_command(const SceneArgs& args, std::optional<std::uint64_t> steps, std::
 
 int resolve_command(const SceneArgs& args, bool json) {
   const Scene scene = load(args);
-  PluginHost host;
-  std::unique_ptr<World> world = build_world(scene, host);
-  if (!world->has_detector() || !world->has_resolver())
-    throw Error(scene.file.string() + ": resolve needs a detector and a resolver (modules.detector and "
-                "modules.resolver are 'none')");
-  const StepStatus& status = world->detect_and_resolve();
-  if (!status.ok) throw Error(scene.file.string() + ": " + status.message);
-  const nlohmann::json report = cli::resolve_report(*world, scene.resolver.plugin, status.profile.resolve);
+  const nlohmann::json report = cli::resolve_scene(scene);
   if (json) {
     std::cout << report.dump(2) << "\n";
     return 0;
   }
   std::cout << "resolver " << scene.resolver.plugin << ": " << report["contacts"].size() << " contacts, "
-            << report["iterations"] << " rounds, " << status.profile.resolve << " s, residual "
-            << status.resolver.residual << " m/s\n";
+            << report["iterations"] << " rounds, " << report["time_s"].get<double>() << " s, residual "
+            << report["residual"].get<double>() << " m/s\n";
   for (const auto& c : report["contacts"])
     std::cout << "  " << c["a"].get<std::string>() << " - " << c["b"].get<std::string>() << "  depth "
               << c["depth"] << "  impulse " << c["impulse"] << "\n";

@@ -419,6 +419,17 @@ nlohmann::json run_summary(const Scene& scene, const World& world, const RunStat
   return summary;
 }
 
+nlohmann::json resolve_scene(const Scene& scene) {
+  PluginHost host;
+  std::unique_ptr<World> world = build_world(scene, host);
+  if (!world->has_detector() || !world->has_resolver())
+    throw Error(scene.file.string() + ": resolve needs a detector and a resolver (modules.detector and "
+                "modules.resolver are 'none')");
+  const StepStatus& status = world->detect_and_resolve();
+  if (!status.ok) throw Error(scene.file.string() + ": " + status.message);
+  return resolve_report(*world, scene.resolver.plugin, status.profile.resolve);
+}
+
 void write_file(const std::filesystem::path& file, std::string_view data) {
   std::ofstream out(file, std::ios::binary | std::ios::trunc);
   if (!out) throw Error(file.string() + ": cannot open for writing");

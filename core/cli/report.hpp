@@ -157,6 +157,10 @@ void write_body_table(const std::filesystem::path& file, bool overwrite, const s
 /// The `resolve --json` document (README.md, "The `impetus` tool").
 nlohmann::json resolve_report(const World& world, const std::string& resolver, double seconds);
 
+/// The `impetus resolve` experiment: one detection and one resolution on the scene's initial state, with
+/// its `--json` document. Throws Error naming the scene without a detector or resolver, or when it fails.
+nlohmann::json resolve_scene(const Scene& scene);
+
 /// The `plugins --json` document.
 nlohmann::json plugins_report(const PluginListing& listing);
 /// Prints the plugin listing for people.

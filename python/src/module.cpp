@@ -368,16 +368,7 @@ PYBIND11_MODULE(_impetus, m) {
   m.def("measure", &measure_world, py::arg("world"),
         "Kinetic and potential energy (J), linear and angular momentum about the origin, the deepest "
         "penetration and the number of contacts of the last detection");
-  m.def("_resolve", [](const Scene& scene) {
-    PluginHost host;
-    std::unique_ptr<World> world = build_world(scene, host);
-    if (!world->has_detector() || !world->has_resolver())
-      throw Error(scene.file.string() + ": resolve needs a detector and a resolver (modules.detector and "
-                  "modules.resolver are 'none')");
-    const StepStatus& status = world->detect_and_resolve();
-    if (!status.ok) throw Error(scene.file.string() + ": " + status.message);
-    return cli::resolve_report(*world, scene.resolver.plugin, status.profile.resolve).dump();
-  });
+  m.def("_resolve", [](const Scene& scene) { return cli::resolve_scene(scene).dump(); });
   m.def("_plugins", [] {
     PluginHost host;
     return cli::plugins_report(host.discover()).dump();

@@ -316,6 +316,13 @@ TEST(CliViewer, ChromiumDrawsTheBallWhereItsPoseSays) {
     EXPECT_NEAR(picked["selected"]["velocity"][k].get<double>(), rows[early].velocity[k], 1e-6);
     EXPECT_NEAR(picked["selected"]["position"][k].get<double>(), rows[early].position[k], 1e-6);
   }
+  // A run exported as .gltf (JSON, its buffer a data: address) makes a page that loads the same way.
+  const fs::path gltf = temp_dir() / "run.gltf", gltf_page = temp_dir() / "run_gltf.html";
+  ASSERT_EQ(run(kExe + " run " + kScene + " --steps " + std::to_string(kSteps) + " --out " + gltf.string()).status, 0);
+  ASSERT_EQ(run(kExe + " view " + gltf.string() + " --out " + gltf_page.string()).status, 0);
+  const nlohmann::json from_gltf = page_status(gltf_page, camera_hash(rows[early].time) + "&select=marker");
+  EXPECT_TRUE(from_gltf["errors"].empty()) << from_gltf.dump();
+  EXPECT_EQ(from_gltf["selected"], picked["selected"]);
   // Opened without a time, the page plays: at 4× the one-second run is over well within Chromium's
   // (virtual) ten seconds, and it stops at the end.
   const nlohmann::json played = page_status(o.page, "speed=4");
