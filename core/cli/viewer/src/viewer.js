@@ -330,6 +330,7 @@ function main(run, options) {
       errors: window.impetusErrors,
       warnings: window.impetusWarnings,
       time: state.time,
+      playing: state.playing,
       duration,
       samples: run.times.length,
       bodies: run.bodies.length,
@@ -344,7 +345,8 @@ function main(run, options) {
 
   let last = performance.now();
   renderer.setAnimationLoop((now) => {
-    const elapsed = Math.min((now - last) / 1000, 0.1);
+    // The first frame's time can precede the clock read above: never step backwards, nor more than 0.1 s.
+    const elapsed = Math.min(Math.max((now - last) / 1000, 0), 0.1);
     last = now;
     if (state.playing) {
       state.time += elapsed * state.speed;
