@@ -8,9 +8,11 @@
 // detect_ms, resolve_ms, positions_ms) plus resolve_share = resolve / total.
 // The resolvers run with their defaults (position correction on, warm starts on), as in a simulation.
 // With friction ("…_mu0.7"): the pyramid at rest (spheres at zero velocity, μ = 0.7 everywhere, where an
-// equilibrium exists) and stacks of N unit boxes on the ground (μ = 0.5), each step the frictional
-// problem of a resting scene; counters add natural_map (ledas's natural-map residual), sticking and
-// sliding.
+// equilibrium exists), stacks of N unit boxes on the ground (μ = 0.5) and brick walls in running bond
+// (μ = 0.5; 40 and 80 bricks, 10 per course), each step the frictional problem of a resting scene;
+// counters add natural_map (ledas's natural-map residual), sticking and sliding. The walls of 200 and
+// 1,000 bricks (25 per course) run only with IMPETUS_BENCH_SLOW=1: one step of the 200-brick wall takes
+// ledas 10-140 s today (benchmarks/README.md), so the default suite would not finish.
 #include "support/bench_main.hpp"
 #include "support/bench_resolvers.hpp"
 #include "support/bench_scenes.hpp"
@@ -52,7 +54,32 @@ std::vector<RigidBody> make_stack(int n, double mu) {
   return bodies;
 }
 
-enum class Scene { pyramid, line, resting_pyramid, stack };
+// A wall of `courses` × `per_course` bricks (0.4 × 0.2 × 0.2 m, 16 kg: 1000 kg/m³) in running bond on a
+// fixed ground plane: every other course shifted by half a brick, so each brick rests on two below it and
+// the wall is one island. Each brick is 1e-5 m into the course below it, friction μ everywhere.
+std::vector<RigidBody> make_wall(int courses, int per_course, double mu) {
+  const Vec3 size(0.4, 0.2, 0.2);
+  std::vector<RigidBody> bodies;
+  for (int c = 0; c < courses; ++c)
+    for (int i = 0; i < per_course; ++i) {
+      RigidBody brick;
+      brick.name = "brick_" + std::to_string(c) + "_" + std::to_string(i);
+      brick.shape = Box{size};
+      set_primitive_mass(brick, 1000.0 * size.prod());
+      brick.position = Vec3((i + 0.5 * (c % 2)) * size.x(), 0.0, 0.5 * size.z() + c * (size.z() - 1e-5) - 1e-5);
+      brick.material.friction = mu;
+      bodies.push_back(brick);
+    }
+  RigidBody ground;
+  ground.name = "ground";
+  ground.shape = Plane{Vec3(0, 0, 1), 0.0};
+  make_fixed(ground);
+  ground.material.friction = mu;
+  bodies.push_back(ground);
+  return bodies;
+}
+
+enum class Scene { pyramid, line, resting_pyramid, stack, wall };
 
 void step(benchmark::State& state, const std::string& resolver_name, Scene scene, int n, double restitution,
           bool speculative = true) {
@@ -60,6 +87,7 @@ void step(benchmark::State& state, const std::string& resolver_name, Scene scene
       scene == Scene::pyramid ? make_pyramid(PyramidParams{.rows = n, .restitution = restitution})
       : scene == Scene::line  ? make_line(LineParams{.count = n, .restitution = restitution})
       : scene == Scene::stack ? make_stack(n, 0.5)
+      : scene == Scene::wall  ? make_wall(n / (n < 200 ? 10 : 25), n < 200 ? 10 : 25, 0.5)
                               : make_pyramid(PyramidParams{.rows = n, .velocity = Vec3::Zero(), .friction = 0.7});
   WorldSettings settings;  // dt 1 ms, gravity −9.81 m/s² along z
   World world(settings);
@@ -83,7 +111,7 @@ void step(benchmark::State& state, const std::string& resolver_name, Scene scene
   state.counters["positions_ms"] = benchmark::Counter(1e3 * sum.positions, per_step);
   state.counters["cold_ms"] = cold_ms;
   state.counters["resolve_share"] = sum.total > 0 ? sum.resolve / sum.total : 0.0;
-  if (scene == Scene::resting_pyramid || scene == Scene::stack) {
+  if (scene == Scene::resting_pyramid || scene == Scene::stack || scene == Scene::wall) {
     // Only ledas reports it (mirtich's sequential impulses have no problem-wide residual: 0 would mislead).
     if (resolver_name.starts_with("ledas")) state.counters["natural_map"] = last.resolver.natural_map_residual;
     state.counters["sticking"] = static_cast<double>(last.resolver.sticking);
@@ -112,6 +140,13 @@ int register_all() {
         benchmark::RegisterBenchmark(("step/" + resolver + "/stack_" + std::to_string(n) + "_mu0.5").c_str(),
                                      [resolver, n](benchmark::State& st) { step(st, resolver, Scene::stack, n, 0.0); })
             ->Unit(benchmark::kMillisecond);
+      const bool slow = std::getenv("IMPETUS_BENCH_SLOW") != nullptr;
+      for (int n : {40, 80, 200, 1000}) {
+        if (n > max_bodies || (n >= 200 && !slow)) continue;
+        benchmark::RegisterBenchmark(("step/" + resolver + "/wall_" + std::to_string(n) + "_mu0.5").c_str(),
+                                     [resolver, n](benchmark::State& st) { step(st, resolver, Scene::wall, n, 0.0); })
+            ->Unit(benchmark::kMillisecond);
+      }
     }
     // Speculative contacts off: what the look-ahead costs where nothing is fast (compare with the rows
     // above; detection/fcl/README.md, "Fast bodies").
