@@ -33,6 +33,16 @@ namespace {
 
 using namespace impetus;
 
+// A fixed ground plane z = 0 with friction μ, last in `bodies`.
+void add_ground(std::vector<RigidBody>& bodies, double mu) {
+  RigidBody ground;
+  ground.name = "ground";
+  ground.shape = Plane{Vec3(0, 0, 1), 0.0};
+  make_fixed(ground);
+  ground.material.friction = mu;
+  bodies.push_back(ground);
+}
+
 // N unit boxes (1 kg) stacked on a fixed ground plane, each 1e-5 m into the one below, friction μ.
 std::vector<RigidBody> make_stack(int n, double mu) {
   std::vector<RigidBody> bodies;
@@ -45,12 +55,7 @@ std::vector<RigidBody> make_stack(int n, double mu) {
     box.material.friction = mu;
     bodies.push_back(box);
   }
-  RigidBody ground;
-  ground.name = "ground";
-  ground.shape = Plane{Vec3(0, 0, 1), 0.0};
-  make_fixed(ground);
-  ground.material.friction = mu;
-  bodies.push_back(ground);
+  add_ground(bodies, mu);
   return bodies;
 }
 
@@ -70,12 +75,7 @@ std::vector<RigidBody> make_wall(int courses, int per_course, double mu) {
       brick.material.friction = mu;
       bodies.push_back(brick);
     }
-  RigidBody ground;
-  ground.name = "ground";
-  ground.shape = Plane{Vec3(0, 0, 1), 0.0};
-  make_fixed(ground);
-  ground.material.friction = mu;
-  bodies.push_back(ground);
+  add_ground(bodies, mu);
   return bodies;
 }
 
