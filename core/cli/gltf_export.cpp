@@ -278,7 +278,7 @@ void GltfRecorder::record(const World& world) {
     push3(angular_velocities_[i], bodies[i].angular_velocity);
   }
   // Contacts are what a run cannot bound in advance: once they would pass the cap, the rest of the run
-  // records none, and the file says so (extras "contacts_complete": false).
+  // records none, and the file says so (asset extras contacts.complete: false).
   const std::span<const Contact> contacts = world.contacts();
   const std::uint64_t more = static_cast<std::uint64_t>(kContactBytes) * contacts.size();
   if (contacts_complete_ && bytes_ + more > kMaxAnimationBytes) {
@@ -382,8 +382,8 @@ std::string GltfRecorder::serialize(const World& world, bool binary) const {
   model.scenes.push_back(scene);
   model.defaultScene = 0;
 
-  // One animation: every recorded time, and per moving body a translation and a rotation sampler.
   // The sample times: the animation's input, and the time axis of the series in extras.
+  // One animation: every recorded time, and per moving body a translation and a rotation sampler.
   const int input = times_.empty() ? -1 : add_floats(model, times_, TINYGLTF_TYPE_SCALAR, 1, 0, true);
   if (!times_.empty()) {
     tinygltf::Animation animation;

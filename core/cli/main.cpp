@@ -136,8 +136,9 @@ struct RunOutputs {
 };
 
 // What a run's output file may be called: --out FILE.csv (trajectory), FILE.glb or FILE.gltf (glTF 2.0),
-// FILE.html (the viewer page); --contacts FILE.csv. A device or a pipe (/dev/stdout, even redirected to a file) takes CSV whatever its
-// name. Anything else is refused rather than guessed (README.md, "The `impetus` tool").
+// FILE.html (the viewer page); --contacts FILE.csv. A device or a pipe (/dev/stdout, even redirected to a
+// file) takes CSV whatever its name. Anything else is refused rather than guessed (README.md, "The
+// `impetus` tool").
 void check_extension(const std::string& option, const std::filesystem::path& file) {
   std::error_code ec;
   if (file.string().starts_with("/dev/") ||
