@@ -20,6 +20,8 @@ packages=(
   chromium libpng-dev
   # the Python package (python/): bindings, numpy state, its tests, sweeps on Dask
   python3-dev pybind11-dev python3-numpy python3-pytest python3-distributed python3-yaml
+  # islands and the narrowphase on every core (oneTBB: the world's thread arena, parallel_for)
+  libtbb-dev
 )
 
 as_root=()

@@ -7,6 +7,10 @@
 #include "impetus/detection/fcl/mesh_contacts.hpp"
 #include "impetus/detection/fcl/shapes.hpp"
 
+#include <tbb/blocked_range.h>
+#include <tbb/enumerable_thread_specific.h>
+#include <tbb/parallel_for.h>
+
 #include <algorithm>
 #include <limits>
 #include <unordered_map>
@@ -121,9 +125,23 @@ struct FclDetector::Impl {
   double thinnest = 0.0;                // the smallest inner radius of any body (m)
   Broadphase broadphase;
   std::vector<BodyPair> pairs;
-  std::vector<ManifoldPoint> points;
-  std::vector<ManifoldPoint> speculative_points;  // a speculative pair's contacts while it is advanced
-  MeshContacts mesh;
+  // The narrowphase runs on consecutive runs of kPairsPerChunk pairs in parallel, each thread with its
+  // own scratch; a chunk's contacts and counts are its own, and the chunks are joined in pair order, so
+  // the list is the same for every thread count.
+  struct Worker {
+    PairSettings pair;
+    std::vector<ManifoldPoint> points;
+    std::vector<ManifoldPoint> speculative_points;  // a speculative pair's contacts while it is advanced
+    MeshContacts mesh;
+    std::uint64_t fcl_failures = 0;
+  };
+  struct Chunk {
+    std::vector<Contact> contacts;
+    std::uint64_t calls = 0, dropped = 0, speculative = 0;
+  };
+  static constexpr std::size_t kPairsPerChunk = 32;
+  tbb::enumerable_thread_specific<Worker> workers;
+  std::vector<Chunk> chunks;
   FclDetectorProfile profile;
   bool ready = false;
 
@@ -135,10 +153,12 @@ struct FclDetector::Impl {
   }
   ModuleStatus add_body(const RigidBody& body, BodyIndex index, MeshCache& meshes);
   bool filtered(BodyIndex a, BodyIndex b) const;
-  void narrow(const Placed& a, const Placed& b, const Body& ba, const Body& bb);
-  bool meets_within_step(const Placed& a, const Placed& b, const RigidBody& ra, const RigidBody& rb, BodyIndex ia,
-                         BodyIndex ib, double dt, double closing);
-  std::uint64_t finish_pair(BodyIndex a, BodyIndex b, double scale, std::vector<Contact>& contacts);
+  void narrow_pair(Worker& w, BodyIndex a, BodyIndex b, std::span<const RigidBody> state, double dt,
+                   bool speculative, Chunk& out);
+  void narrow(Worker& w, const Placed& a, const Placed& b, const Body& ba, const Body& bb);
+  bool meets_within_step(Worker& w, const Placed& a, const Placed& b, const RigidBody& ra, const RigidBody& rb,
+                         BodyIndex ia, BodyIndex ib, double dt, double closing);
+  std::uint64_t finish_pair(Worker& w, BodyIndex a, BodyIndex b, double scale, std::vector<Contact>& contacts);
 };
 
 bool FclDetector::Impl::filtered(BodyIndex a, BodyIndex b) const {
@@ -321,37 +341,31 @@ void FclDetector::detect(std::span<const RigidBody> bodies, const StepContext& c
   // could pass through, or so deep into the other that the normal flips) is searched with its margin
   // grown by that closing distance: speculative contacts, with depth = −gap, which the resolvers let
   // close exactly at the end of the step (detection/fcl/README.md, "Fast bodies").
-  for (const auto& [a, b] : s.pairs) {
-    ++counters.narrowphase_calls;
-    const Placed pa = s.placed(bodies[a], a), pb = s.placed(bodies[b], b);
-    if (!pa.x.allFinite() || !pa.R.allFinite() || !pb.x.allFinite() || !pb.R.allFinite()) continue;
-    s.points.clear();
-    s.pair.margin = margin;
-    bool speculative_pair = false;
-    double closing = 0.0;  // how far the pair's surfaces can close within the step, at most (m)
-    // The two reaches bound the closing: most pairs are ruled out without the exact bound.
-    const double thinner = 0.5 * std::min(s.bodies[a].inner, s.bodies[b].inner);
-    if (speculative && s.reach[a] + s.reach[b] > margin && s.reach[a] + s.reach[b] > thinner) {
-      const RigidBody &ra = bodies[a], &rb = bodies[b];
-      closing =
-          ctx.dt * ((rb.velocity - ra.velocity).norm() + ra.angular_velocity.norm() * pa.size() +
-                    rb.angular_velocity.norm() * pb.size());
-      if (closing > margin && closing > thinner && std::isfinite(closing)) {
-        s.pair.margin = margin + closing;
-        speculative_pair = true;
-        ++counters.speculative_pairs;
-      }
+  const std::size_t chunk_count = (s.pairs.size() + Impl::kPairsPerChunk - 1) / Impl::kPairsPerChunk;
+  if (s.chunks.size() < chunk_count) s.chunks.resize(chunk_count);
+  const auto run_chunks = [&](const tbb::blocked_range<std::size_t>& range) {
+    Impl::Worker& w = s.workers.local();
+    for (std::size_t c = range.begin(); c != range.end(); ++c) {
+      Impl::Chunk& out = s.chunks[c];
+      out.contacts.clear();
+      out.calls = out.dropped = out.speculative = 0;
+      const std::size_t end = std::min(s.pairs.size(), (c + 1) * Impl::kPairsPerChunk);
+      for (std::size_t k = c * Impl::kPairsPerChunk; k < end; ++k)
+        s.narrow_pair(w, s.pairs[k].first, s.pairs[k].second, bodies, ctx.dt, speculative, out);
     }
-    s.narrow(pa, pb, s.bodies[a], s.bodies[b]);
-    // Speculative contacts are kept only if the bodies really meet within the step: a ball flying past
-    // an edge has a closest point ahead of it, but never reaches it.
-    if (speculative_pair && !s.points.empty() &&
-        !s.meets_within_step(pa, pb, bodies[a], bodies[b], a, b, ctx.dt, closing))
-      s.points.clear();
-    const double scale = pa.kind() == ShapeKind::plane   ? pb.size()
-                         : pb.kind() == ShapeKind::plane ? pa.size()
-                                                         : std::min(pa.size(), pb.size());
-    counters.contacts_dropped += s.finish_pair(a, b, scale, contacts);
+  };
+  if (chunk_count > 1) tbb::parallel_for(tbb::blocked_range<std::size_t>(0, chunk_count, 1), run_chunks);
+  else run_chunks(tbb::blocked_range<std::size_t>(0, chunk_count, 1));
+  for (std::size_t c = 0; c < chunk_count; ++c) {
+    const Impl::Chunk& out = s.chunks[c];
+    contacts.insert(contacts.end(), out.contacts.begin(), out.contacts.end());
+    counters.narrowphase_calls += out.calls;
+    counters.contacts_dropped += out.dropped;
+    counters.speculative_pairs += out.speculative;
+  }
+  for (Impl::Worker& w : s.workers) {
+    s.profile.fcl_failures += w.fcl_failures;
+    w.fcl_failures = 0;
   }
   counters.contacts += contacts.size();
   const auto end = Clock::now();
@@ -359,28 +373,63 @@ void FclDetector::detect(std::span<const RigidBody> bodies, const StepContext& c
   s.profile.narrowphase = seconds(broad_end, end);
 }
 
-void FclDetector::Impl::narrow(const Placed& a, const Placed& b, const Body& ba, const Body& bb) {
+// One pair's manifold into `out` (the narrowphase of detect(), on a worker's scratch).
+void FclDetector::Impl::narrow_pair(Worker& w, BodyIndex a, BodyIndex b, std::span<const RigidBody> state,
+                                    double dt, bool speculative, Chunk& out) {
+  const double margin = settings.margin;
+  ++out.calls;
+  const Placed pa = placed(state[a], a), pb = placed(state[b], b);
+  if (!pa.x.allFinite() || !pa.R.allFinite() || !pb.x.allFinite() || !pb.R.allFinite()) return;
+  w.points.clear();
+  w.pair = pair;
+  bool speculative_pair = false;
+  double closing = 0.0;  // how far the pair's surfaces can close within the step, at most (m)
+  // The two reaches bound the closing: most pairs are ruled out without the exact bound.
+  const double thinner = 0.5 * std::min(bodies[a].inner, bodies[b].inner);
+  if (speculative && reach[a] + reach[b] > margin && reach[a] + reach[b] > thinner) {
+    const RigidBody &ra = state[a], &rb = state[b];
+    closing = dt * ((rb.velocity - ra.velocity).norm() + ra.angular_velocity.norm() * pa.size() +
+                    rb.angular_velocity.norm() * pb.size());
+    if (closing > margin && closing > thinner && std::isfinite(closing)) {
+      w.pair.margin = margin + closing;
+      speculative_pair = true;
+      ++out.speculative;
+    }
+  }
+  narrow(w, pa, pb, bodies[a], bodies[b]);
+  // Speculative contacts are kept only if the bodies really meet within the step: a ball flying past
+  // an edge has a closest point ahead of it, but never reaches it.
+  if (speculative_pair && !w.points.empty() &&
+      !meets_within_step(w, pa, pb, state[a], state[b], a, b, dt, closing))
+    w.points.clear();
+  const double scale = pa.kind() == ShapeKind::plane   ? pb.size()
+                       : pb.kind() == ShapeKind::plane ? pa.size()
+                                                       : std::min(pa.size(), pb.size());
+  out.dropped += finish_pair(w, a, b, scale, out.contacts);
+}
+
+void FclDetector::Impl::narrow(Worker& w, const Placed& a, const Placed& b, const Body& ba, const Body& bb) {
   const ShapeKind ka = a.kind(), kb = b.kind();
-  if (ka == ShapeKind::plane || kb == ShapeKind::plane) return halfspace_contacts(a, b, pair, points);
+  if (ka == ShapeKind::plane || kb == ShapeKind::plane) return halfspace_contacts(a, b, w.pair, w.points);
   if (ka == ShapeKind::triangles && kb == ShapeKind::triangles)
-    return mesh.mesh_vs_mesh(a, *ba.fcl, b, *bb.fcl, pair, points, profile.fcl_failures);
+    return w.mesh.mesh_vs_mesh(a, *ba.fcl, b, *bb.fcl, w.pair, w.points, w.fcl_failures);
   if (ka == ShapeKind::triangles)
-    return mesh.mesh_vs_convex(a, *ba.fcl, b, *bb.fcl, true, pair, points, profile.fcl_failures);
+    return w.mesh.mesh_vs_convex(a, *ba.fcl, b, *bb.fcl, true, w.pair, w.points, w.fcl_failures);
   if (kb == ShapeKind::triangles)
-    return mesh.mesh_vs_convex(b, *bb.fcl, a, *ba.fcl, false, pair, points, profile.fcl_failures);
-  if (is_rounded(ka) && is_rounded(kb)) return rounded_contacts(a, b, pair, points);
+    return w.mesh.mesh_vs_convex(b, *bb.fcl, a, *ba.fcl, false, w.pair, w.points, w.fcl_failures);
+  if (is_rounded(ka) && is_rounded(kb)) return rounded_contacts(a, b, w.pair, w.points);
   if ((ka == ShapeKind::sphere && kb == ShapeKind::box) || (ka == ShapeKind::box && kb == ShapeKind::sphere))
-    return sphere_box_contacts(a, b, pair, points);
+    return sphere_box_contacts(a, b, w.pair, w.points);
   if (ka == ShapeKind::box && kb == ShapeKind::box) {
     const AxisResult axis = box_box_axis(a, b);
-    if (axis.overlap >= -pair.margin) convex_contacts(a, b, axis, pair, points);
+    if (axis.overlap >= -w.pair.margin) convex_contacts(a, b, axis, w.pair, w.points);
     return;
   }
   // Generic convex pair: FCL's signed distance gives the gap or the penetration with witness points;
   // its normal is then checked and sharpened against the shapes' own face normals.
   const SignedDistance sd = fcl_signed_distance(*ba.fcl, a, *bb.fcl, b);
-  if (!sd.ok) ++profile.fcl_failures;
-  if (sd.ok && sd.distance > pair.margin) return;
+  if (!sd.ok) ++w.fcl_failures;
+  if (sd.ok && sd.distance > w.pair.margin) return;
   const double eps = 1e-12 * (a.size() + b.size());
   Vec3 fcl_normal = Vec3::Zero();
   if (sd.ok && sd.distance > eps) fcl_normal = (sd.on_b - sd.on_a).normalized();
@@ -395,7 +444,7 @@ void FclDetector::Impl::narrow(const Placed& a, const Placed& b, const Body& ba,
   candidates.push_back(hint);  // last: a face normal wins a tie
   const AxisResult axis =
       least_overlap_axis(a, b, {candidates.begin(), candidates.end()}, 1e-12 * (a.size() + b.size()));
-  if (axis.valid && axis.overlap >= -pair.margin) convex_contacts(a, b, axis, pair, points);
+  if (axis.valid && axis.overlap >= -w.pair.margin) convex_contacts(a, b, axis, w.pair, w.points);
 }
 
 // Conservative advancement over the step (the classic time-of-impact bound, as FCL's continuous
@@ -403,16 +452,16 @@ void FclDetector::Impl::narrow(const Placed& a, const Placed& b, const Body& ba,
 // time their gap allows (the gap over a bound on how fast it can close: the relative velocity along the
 // closest normal, plus |ω| times each bounding radius), until the gap is within the margin (they meet:
 // true), the step is over, or nothing is left within the remaining look-ahead (they do not: false).
-// Leaves s.points as they were on entry (the contacts now).
-bool FclDetector::Impl::meets_within_step(const Placed& a, const Placed& b, const RigidBody& ra, const RigidBody& rb,
-                                          BodyIndex ia, BodyIndex ib, double dt, double closing) {
+// Leaves w.points as they were on entry (the contacts now).
+bool FclDetector::Impl::meets_within_step(Worker& w, const Placed& a, const Placed& b, const RigidBody& ra,
+                                          const RigidBody& rb, BodyIndex ia, BodyIndex ib, double dt, double closing) {
   const double margin = settings.margin;
   const auto deepest = [](const std::vector<ManifoldPoint>& p) {
     return *std::max_element(p.begin(), p.end(),
                              [](const ManifoldPoint& l, const ManifoldPoint& r) { return l.depth < r.depth; });
   };
-  if (-deepest(points).depth <= margin) return true;  // touching already
-  speculative_points = points;
+  if (-deepest(w.points).depth <= margin) return true;  // touching already
+  w.speculative_points = w.points;
   const double spin = ra.angular_velocity.norm() * a.size() + rb.angular_velocity.norm() * b.size();
   const Vec3 dv = rb.velocity - ra.velocity;
   // Between convex shapes in translation the gap is a convex function of time, so its slope along the
@@ -422,11 +471,11 @@ bool FclDetector::Impl::meets_within_step(const Placed& a, const Placed& b, cons
   bool meets = true;  // undecided within the budget: keep the contacts
   double tau = 0.0;
   for (int iteration = 0; iteration < kAdvanceIterations; ++iteration) {
-    if (points.empty()) {
+    if (w.points.empty()) {
       meets = false;  // nothing within the look-ahead left for the rest of the step
       break;
     }
-    const ManifoldPoint closest = deepest(points);
+    const ManifoldPoint closest = deepest(w.points);
     const double gap = -closest.depth;
     if (gap <= margin) break;
     const double rate = (convex ? std::abs(dv.dot(closest.normal)) : dv.norm()) + spin;
@@ -439,38 +488,39 @@ bool FclDetector::Impl::meets_within_step(const Placed& a, const Placed& b, cons
       meets = false;
       break;
     }
-    points.clear();
-    pair.margin = margin + closing * (1.0 - tau / dt);
-    narrow(advanced(a, ra, tau), advanced(b, rb, tau), bodies[ia], bodies[ib]);
+    w.points.clear();
+    w.pair.margin = margin + closing * (1.0 - tau / dt);
+    narrow(w, advanced(a, ra, tau), advanced(b, rb, tau), bodies[ia], bodies[ib]);
   }
-  points.swap(speculative_points);
+  w.points.swap(w.speculative_points);
   return meets;
 }
 
-std::uint64_t FclDetector::Impl::finish_pair(BodyIndex a, BodyIndex b, double scale, std::vector<Contact>& contacts) {
+std::uint64_t FclDetector::Impl::finish_pair(Worker& w, BodyIndex a, BodyIndex b, double scale,
+                                            std::vector<Contact>& contacts) {
   std::uint64_t dropped = 0;
   // A NaN or zero normal never reaches a resolver.
   std::size_t kept = 0;
-  for (std::size_t i = 0; i < points.size(); ++i) {
-    ManifoldPoint p = points[i];
+  for (std::size_t i = 0; i < w.points.size(); ++i) {
+    ManifoldPoint p = w.points[i];
     const double len = p.normal.norm();
     if (!p.point.allFinite() || !std::isfinite(p.depth) || !std::isfinite(len) || len < 1e-9) {
       ++dropped;
       continue;
     }
     p.normal /= len;
-    points[kept++] = p;
+    w.points[kept++] = p;
   }
-  points.resize(kept);
-  dropped += merge_duplicates(points, settings.merge_tolerance * scale);
-  dropped += reduce_to_spanning(points, static_cast<std::size_t>(settings.max_contacts_per_pair));
+  w.points.resize(kept);
+  dropped += merge_duplicates(w.points, settings.merge_tolerance * scale);
+  dropped += reduce_to_spanning(w.points, static_cast<std::size_t>(settings.max_contacts_per_pair));
   // Pairs come in (a, b) order; sorting each manifold by (feature, point) makes the whole list sorted
   // by (a, b, feature, point), independent of how the manifold was assembled.
-  std::sort(points.begin(), points.end(), [](const ManifoldPoint& l, const ManifoldPoint& r) {
+  std::sort(w.points.begin(), w.points.end(), [](const ManifoldPoint& l, const ManifoldPoint& r) {
     return std::tie(l.feature, l.point.x(), l.point.y(), l.point.z()) <
            std::tie(r.feature, r.point.x(), r.point.y(), r.point.z());
   });
-  for (const ManifoldPoint& p : points) contacts.push_back(Contact{a, b, p.point, p.normal, p.depth, p.feature, 0.0});
+  for (const ManifoldPoint& p : w.points) contacts.push_back(Contact{a, b, p.point, p.normal, p.depth, p.feature, 0.0});
   return dropped;
 }
 

@@ -1,6 +1,7 @@
 // The complementary mode: each round solves the exact inelastic impact (a linear complementarity
 // problem over the approaching and touching rows, island_solver.hpp), then applies (1 + e) p.
 #include "island.hpp"
+#include "lane.hpp"
 #include "impetus/resolution/ledas/ledas.hpp"
 
 #include <cmath>
@@ -10,14 +11,14 @@ namespace impetus {
 using ledas::Vector;
 // The exact impact (a linear complementarity problem), then (1 + e) p. Restitution can make a contact
 // approach again (a separating contact pushed shut gets −e v_n⁻), so the round repeats while any does.
-void LedasResolver::velocity_complementary(ledas::Island& island, std::span<RigidBody> bodies, ResolverCounters& counters) {
+void LedasResolver::velocity_complementary(ledas::Island& island, std::span<RigidBody> bodies, Lane& lane) {
   const std::size_t m = island.rows.size();
   ledas::ComplementarityProblem problem;
   problem.matrix = &island.a;
   problem.equality = island.equality;
   problem.start.resize(m);
   problem.tolerance = settings_.tolerance;
-  const std::uint64_t failed_before = stats_.velocity.infeasible, unconverged_before = stats_.velocity.non_converged;
+  const std::uint64_t failed_before = lane.stats.velocity.infeasible, unconverged_before = lane.stats.velocity.non_converged;
   for (std::uint64_t round = 0;; ++round) {
     const Vector& v = current_velocities(island, bodies);  // (finish_round changes it: not used after)
     bool needed = ledas::retarget_joints(island, rows_, info_, v, bodies) && round > 0;
@@ -38,17 +39,18 @@ void LedasResolver::velocity_complementary(ledas::Island& island, std::span<Rigi
     if (!needed) break;
     // Rounds are bounded by work too: a round repeats only because restitution made a contact approach
     // again; one whose solve failed (no solution, or stopped unconverged) would fail the same way again.
-    if (round == settings_.max_rounds || round == ledas::work_budget(m, solver_.settings())) {
-      ++counters.non_converged;
+    if (round == settings_.max_rounds || round == ledas::work_budget(m, solver_settings_)) {
+      ++lane.counters.non_converged;
       break;
     }
-    if (round > 0 && (stats_.velocity.infeasible > failed_before || stats_.velocity.non_converged > unconverged_before))
+    if (round > 0 &&
+        (lane.stats.velocity.infeasible > failed_before || lane.stats.velocity.non_converged > unconverged_before))
       break;  // counted by the solver already
-    if (settings_.start_set == LedasStartSet::impact) narrow_start_set(island, v, problem.start);
+    if (settings_.start_set == LedasStartSet::impact) narrow_start_set(lane, island, v, problem.start);
     problem.rhs = target - v;
-    const std::uint64_t before = stats_.velocity.iterations;
-    const Vector p = solver_.solve_complementarity(problem, stats_.velocity);
-    stats_.systems += stats_.velocity.iterations - before;
+    const std::uint64_t before = lane.stats.velocity.iterations;
+    const Vector p = lane.solver.solve_complementarity(problem, lane.stats.velocity);
+    lane.stats.systems += lane.stats.velocity.iterations - before;
     for (std::size_t i = 0; i < m; ++i)
       if (p(static_cast<Eigen::Index>(i)) != 0.0) island.entered[i] = 1;
     finish_round(island, p, target, bodies);
@@ -67,7 +69,7 @@ void LedasResolver::velocity_complementary(ledas::Island& island, std::span<Rigi
 // must then release; left out, it joins at the next iteration if it would approach. Contacts with a
 // fixed body and contacts between bodies the impact does not reach keep their places (in; out: nothing
 // pushes them).
-void LedasResolver::narrow_start_set(const ledas::Island& island, const Vector& v, std::vector<char>& start) {
+void LedasResolver::narrow_start_set(Lane& lane, const ledas::Island& island, const Vector& v, std::vector<char>& start) {
   const std::size_t m = island.rows.size();
   const auto& slots = island.incidence.slots;
   const auto driving = [&](std::size_t i) {
@@ -75,30 +77,30 @@ void LedasResolver::narrow_start_set(const ledas::Island& island, const Vector& 
     return island.equality[i] ? std::abs(v(ei) - island.target(ei)) > settings_.tolerance
                               : v(ei) < island.target(ei) - settings_.tolerance;
   };
-  hops_.assign(island.bodies.size(), -1);
-  queue_.clear();
+  lane.hops.assign(island.bodies.size(), -1);
+  lane.queue.clear();
   for (std::size_t i = 0; i < m; ++i)
     if (driving(i))
       for (const std::int32_t s : slots[i])
-        if (s >= 0 && hops_[static_cast<std::size_t>(s)] < 0) {
-          hops_[static_cast<std::size_t>(s)] = 0;
-          queue_.push_back(s);
+        if (s >= 0 && lane.hops[static_cast<std::size_t>(s)] < 0) {
+          lane.hops[static_cast<std::size_t>(s)] = 0;
+          lane.queue.push_back(s);
         }
-  for (std::size_t head = 0; head < queue_.size(); ++head) {
-    const std::int32_t s = queue_[head];
+  for (std::size_t head = 0; head < lane.queue.size(); ++head) {
+    const std::int32_t s = lane.queue[head];
     for (const std::uint32_t i : island.incidence.rows_of(s)) {
       if (!start[i]) continue;
       const std::int32_t other = slots[i][0] == s ? slots[i][1] : slots[i][0];
-      if (other >= 0 && hops_[static_cast<std::size_t>(other)] < 0) {
-        hops_[static_cast<std::size_t>(other)] = hops_[static_cast<std::size_t>(s)] + 1;
-        queue_.push_back(other);
+      if (other >= 0 && lane.hops[static_cast<std::size_t>(other)] < 0) {
+        lane.hops[static_cast<std::size_t>(other)] = lane.hops[static_cast<std::size_t>(s)] + 1;
+        lane.queue.push_back(other);
       }
     }
   }
   for (std::size_t i = 0; i < m; ++i) {
     const std::int32_t a = slots[i][0], b = slots[i][1];
     if (start[i] && !island.equality[i] && a >= 0 && b >= 0 &&
-        hops_[static_cast<std::size_t>(a)] == hops_[static_cast<std::size_t>(b)] && !driving(i))
+        lane.hops[static_cast<std::size_t>(a)] == lane.hops[static_cast<std::size_t>(b)] && !driving(i))
       start[i] = 0;
   }
 }

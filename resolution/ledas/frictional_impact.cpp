@@ -2,6 +2,7 @@
 // inelastic frictional impact solved exactly and simultaneously (frictional_solver.hpp), then a
 // restitution phase that is itself a frictional impact, scaled back if it would raise the kinetic energy.
 #include "island.hpp"
+#include "lane.hpp"
 #include "impetus/resolution/ledas/ledas.hpp"
 
 #include <algorithm>
@@ -28,21 +29,22 @@ Vector LedasResolver::warm_start(const ledas::Island& island) const {
 }
 
 // Keeps the island's frictional contacts' inelastic impulses for the next step's warm start.
-void LedasResolver::remember_impulses(const ledas::Island& island, std::span<const Contact> contacts) {
+void LedasResolver::remember_impulses(Lane& lane, const ledas::Island& island, std::span<const Contact> contacts) const {
   for (std::size_t i = 0; i < island.rows.size(); ++i) {
     if (!island.normal_row(i) || !(island.mu[i] > 0.0)) continue;
     const auto ei = static_cast<Eigen::Index>(i);
     const Contact& c = contacts[static_cast<std::size_t>(info_[island.rows[i]].contact)];
-    ContactImpulse& p = next_warm_[ContactKey{c.a, c.b, c.feature}];
+    ContactImpulse p;
     p.normal = island.impulse_inelastic(ei);
     p.tangent = island.impulse_inelastic(ei + 1) * rows_[island.rows[i + 1]].normal +
                 island.impulse_inelastic(ei + 2) * rows_[island.rows[i + 2]].normal;
+    lane.remembered.emplace_back(ContactKey{c.a, c.b, c.feature}, p);
   }
 }
 
 // Solves the island's frictional problem u = A r + q (A = W over the island's rows, q = v − target),
 // tried first from `start` if given.
-Vector LedasResolver::solve_frictional(ledas::Island& island, const Vector& q, const Vector* start) {
+Vector LedasResolver::solve_frictional(Lane& lane, ledas::Island& island, const Vector& q, const Vector* start) {
   ledas::FrictionalProblem problem;
   problem.start = start;
   problem.w = &island.a;
@@ -51,14 +53,14 @@ Vector LedasResolver::solve_frictional(ledas::Island& island, const Vector& q, c
   problem.mu = island.mu;
   problem.dofs = 6 * island.bodies.size();
   problem.tolerance = std::max(kFrictionalRelativeTolerance * q.norm(), kFrictionalAbsoluteTolerance);
-  return friction_solver_.solve(problem, stats_.friction);
+  return lane.friction.solve(problem, lane.stats.friction);
 }
 
 // Applies the impulses p on the island's rows (eq. 3 per row, tangent rows along t1, t2) and adds the
 // tangent rows' work Σ p_t (v_t⁻ + v_t⁺)/2 to friction_work (exact for one simultaneous impulse: ΔE_kin =
 // pᵀ(v⁻ + v⁺)/2 row by row).
 void LedasResolver::apply_island_impulse(ledas::Island& island, const Vector& p, std::span<RigidBody> bodies,
-                                         ResolverCounters& counters) {
+                                         Lane& lane) {
   const Vector before = current_velocities(island, bodies);
   for (std::size_t i = 0; i < island.rows.size(); ++i)
     if (const double pi = p(static_cast<Eigen::Index>(i)); pi != 0.0)
@@ -71,7 +73,7 @@ void LedasResolver::apply_island_impulse(ledas::Island& island, const Vector& p,
       const auto ei = static_cast<Eigen::Index>(i);
       work += 0.5 * p(ei) * (before(ei) + after(ei));
     }
-  counters.friction_work += work;
+  lane.counters.friction_work += work;
   island.impulse_total += p;
 }
 
@@ -80,7 +82,7 @@ void LedasResolver::apply_island_impulse(ledas::Island& island, const Vector& p,
 // are e |v_n⁻| (Newton's rule, simultaneously), which with friction can raise the kinetic energy (Kane's
 // rod); its impulse is then scaled by the largest α ≤ 1 that keeps the energy at or below its pre-impact
 // value (ΔE is quadratic in α), so no impact creates energy for any e ≤ 1.
-void LedasResolver::velocity_frictional(ledas::Island& island, std::span<RigidBody> bodies, ResolverCounters& counters) {
+void LedasResolver::velocity_frictional(ledas::Island& island, std::span<RigidBody> bodies, Lane& lane) {
   const std::size_t m = island.rows.size();
   const Vector v0 = current_velocities(island, bodies);
   const double energy0 = ledas::kinetic_energy(bodies, island.bodies);
@@ -98,19 +100,19 @@ void LedasResolver::velocity_frictional(ledas::Island& island, std::span<RigidBo
     const bool refine = ledas::retarget_joints(island, rows_, info_, v, bodies);
     if (round > 0 && !refine) break;
     if (round == 0 && !needed && !refine) return;
-    const std::uint64_t failures = stats_.friction.non_converged;
+    const std::uint64_t failures = lane.stats.friction.non_converged;
     const Vector warm = round == 0 && settings_.warm_start ? warm_start(island) : Vector();
-    Vector r = solve_frictional(island, v - island.target, warm.size() > 0 && warm.any() ? &warm : nullptr);
+    Vector r = solve_frictional(lane, island, v - island.target, warm.size() > 0 && warm.any() ? &warm : nullptr);
     // A problem left unsolved (counted) still must not create energy: its best iterate is scaled back
     // so that ΔE = rᵀv + ½ rᵀA r ≤ 0 (rows' velocities v before it).
-    if (stats_.friction.non_converged != failures) {
+    if (lane.stats.friction.non_converged != failures) {
       const double linear = r.dot(v), quadratic = 0.5 * r.dot(island.a * r);
       if (linear + quadratic > 0.0) r *= linear < 0.0 && quadratic > 0.0 ? std::min(1.0, -linear / quadratic) : 0.0;
     }
     for (std::size_t i = 0; i < m; ++i)
       if (r(static_cast<Eigen::Index>(i)) != 0.0 && island.normal_row(i)) island.entered[i] = 1;
     island.impulse_inelastic += r;
-    apply_island_impulse(island, r, bodies, counters);
+    apply_island_impulse(island, r, bodies, lane);
     ++island.rounds;
   }
   const Vector v1 = current_velocities(island, bodies);
@@ -127,7 +129,7 @@ void LedasResolver::velocity_frictional(ledas::Island& island, std::span<RigidBo
     bounce = bounce || v1(ei) < target(ei) - settings_.tolerance;
   }
   if (!bounce) return;
-  Vector r = solve_frictional(island, v1 - target);
+  Vector r = solve_frictional(lane, island, v1 - target);
   // ΔE(α) = α rᵀv₁ + ½ α² rᵀ A r; the budget is what phase 1 dissipated.
   const double linear = r.dot(v1), quadratic = 0.5 * r.dot(island.a * r);
   const double budget = std::max(0.0, energy0 - ledas::kinetic_energy(bodies, island.bodies));
@@ -137,9 +139,9 @@ void LedasResolver::velocity_frictional(ledas::Island& island, std::span<RigidBo
                                    (2.0 * quadratic)
                              : (linear < 0.0 ? 1.0 : 0.0);
     r *= std::clamp(alpha, 0.0, 1.0);
-    ++stats_.restitution_capped;
+    ++lane.stats.restitution_capped;
   }
-  apply_island_impulse(island, r, bodies, counters);
+  apply_island_impulse(island, r, bodies, lane);
   ++island.rounds;
 }
 

@@ -292,6 +292,22 @@ bool likely_redundant(const FrictionalProblem& problem) {
 
 }  // namespace
 
+void add(FrictionalStats& into, const FrictionalStats& part) {
+  into.problems += part.problems;
+  into.warm_started += part.warm_started;
+  into.relaxed += part.relaxed;
+  into.fixed_point_steps += part.fixed_point_steps;
+  into.newton_steps += part.newton_steps;
+  into.interior_point_steps += part.interior_point_steps;
+  into.proximal += part.proximal;
+  into.proximal_steps += part.proximal_steps;
+  into.fallbacks += part.fallbacks;
+  into.fallback_sweeps += part.fallback_sweeps;
+  into.non_converged += part.non_converged;
+  into.nan_caught += part.nan_caught;
+  into.residual = std::max(into.residual, part.residual);
+}
+
 void project_on_cone(double mu, double& yn, double& yt1, double& yt2) {
   const double norm = std::hypot(yt1, yt2);
   if (norm <= mu * yn) return;          // inside the cone

@@ -96,4 +96,27 @@ Vector IslandSolver::solve_balanced(const ComplementarityProblem& problem, Solve
   return scale.cwiseProduct(complementarity_->solve(balanced, stats));
 }
 
+void add(SolverStats& into, const SolverStats& part) {
+  into.closed_form += part.closed_form;
+  into.dense += part.dense;
+  into.sparse += part.sparse;
+  into.updated += part.updated;
+  into.singular += part.singular;
+  into.inconsistent += part.inconsistent;
+  into.symbolic_analyses += part.symbolic_analyses;
+  into.symbolic_reused += part.symbolic_reused;
+  into.iterations += part.iterations;
+  into.released += part.released;
+  into.added += part.added;
+  into.non_converged += part.non_converged;
+  into.work_limited += part.work_limited;
+  into.refused += part.refused;
+  into.infeasible += part.infeasible;
+  into.nan_caught += part.nan_caught;
+  into.polished += part.polished;
+  into.proximal += part.proximal;
+  into.refinements += part.refinements;
+  into.sharpened += part.sharpened;
+}
+
 }  // namespace impetus::ledas

@@ -2,7 +2,11 @@
 // phase (paper_rounds.cpp or complementary_impact.cpp), the report into the contacts and counters, and the
 // position correction (position_correction.cpp).
 #include "island.hpp"
+#include "lane.hpp"
 #include "impetus/resolution/ledas/ledas.hpp"
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
 
 #include <algorithm>
 #include <cmath>
@@ -22,13 +26,37 @@ bool valid_contact(const Contact& c, std::size_t body_count) {
 
 }  // namespace
 
+void add(LedasStats& into, const LedasStats& part) {
+  into.islands += part.islands;
+  into.largest_island = std::max(into.largest_island, part.largest_island);
+  into.rounds = std::max(into.rounds, part.rounds);
+  into.systems += part.systems;
+  into.pulling_applied += part.pulling_applied;
+  ledas::add(into.velocity, part.velocity);
+  ledas::add(into.position, part.position);
+  into.kinetic_energy_change += part.kinetic_energy_change;
+  ledas::add(into.friction, part.friction);
+  into.restitution_capped += part.restitution_capped;
+  into.corrections_clamped += part.corrections_clamped;
+  into.duplicate_constraints += part.duplicate_constraints;
+  into.largest_correction = std::max(into.largest_correction, part.largest_correction);
+}
+
 LedasResolver::LedasResolver(const ModuleOptions& options) : LedasResolver(LedasSettings::from_options(options)) {}
 
-LedasResolver::LedasResolver(const LedasSettings& settings) : settings_(settings), solver_([&] {
+LedasResolver::LedasResolver(const LedasSettings& settings) : settings_(settings), solver_settings_([&] {
   ledas::SolverSettings s = settings.solver;
   s.max_iterations = settings.max_rounds;
   return s;
 }()) {}
+
+LedasResolver::~LedasResolver() = default;
+
+LedasResolver::Lane& LedasResolver::lane(std::size_t index) {
+  if (lanes_.size() <= index) lanes_.resize(index + 1);
+  if (!lanes_[index]) lanes_[index] = std::make_unique<Lane>(solver_settings_);
+  return *lanes_[index];
+}
 
 ModuleStatus LedasResolver::accept_constraints(std::span<const Constraint> constraints) noexcept {
   for (std::size_t i = 0; i < constraints.size(); ++i) {
@@ -111,7 +139,30 @@ void LedasResolver::resolve_all(std::span<RigidBody> bodies, std::span<Contact> 
     std::sort(all.begin(), all.end());
     islands.assign(1, std::move(all));
   }
-  for (std::vector<std::uint32_t>& rows : islands) solve_island(std::move(rows), bodies, contacts, ctx.dt, counters);
+  // Island i goes to lane i mod kLanes; the lanes run in parallel (in the caller's thread arena: the
+  // world's `threads`), each on its islands in order. Islands share no movable body, so they write
+  // disjoint bodies, contacts and body slots; everything else a lane writes is its own.
+  const std::size_t used = std::min(islands.size(), kLanes);
+  for (std::size_t k = 0; k < used; ++k) {
+    Lane& l = lane(k);
+    l.stats = LedasStats{};
+    l.counters = ResolverCounters{};
+    l.remembered.clear();
+  }
+  const auto run_lanes = [&](const tbb::blocked_range<std::size_t>& range) {
+    for (std::size_t k = range.begin(); k != range.end(); ++k)
+      for (std::size_t i = k; i < islands.size(); i += kLanes)
+        solve_island(std::move(islands[i]), bodies, contacts, ctx.dt, *lanes_[k]);
+  };
+  if (used > 1) tbb::parallel_for(tbb::blocked_range<std::size_t>(0, used, 1), run_lanes);
+  else run_lanes(tbb::blocked_range<std::size_t>(0, used, 1));
+  // The lanes' results in lane order: the same sums whatever thread ran which lane.
+  for (std::size_t k = 0; k < used; ++k) {
+    const Lane& l = *lanes_[k];
+    add(stats_, l.stats);
+    add(counters, l.counters);
+    for (const auto& [key, impulse] : l.remembered) next_warm_.insert_or_assign(key, impulse);
+  }
 }
 
 // The rows of this step: one per valid contact (eq. 5's direction, eq. 7's arms) and, in complementary
@@ -167,23 +218,23 @@ void LedasResolver::build_rows(std::span<const RigidBody> bodies, std::span<Cont
 
 // One island: the velocity phase by mode, its report, then the position correction.
 void LedasResolver::solve_island(std::vector<std::uint32_t> rows, std::span<RigidBody> bodies,
-                                 std::span<Contact> contacts, double dt, ResolverCounters& counters) {
+                                 std::span<Contact> contacts, double dt, Lane& lane) {
   ledas::Island island = make_island(std::move(rows), bodies, dt);
   const double energy_before = ledas::kinetic_energy(bodies, island.bodies);
-  if (settings_.mode == LedasMode::paper) velocity_paper(island, bodies, counters);
-  else if (island.frictional) velocity_frictional(island, bodies, counters);
-  else velocity_complementary(island, bodies, counters);
+  if (settings_.mode == LedasMode::paper) velocity_paper(island, bodies, lane);
+  else if (island.frictional) velocity_frictional(island, bodies, lane);
+  else velocity_complementary(island, bodies, lane);
   const double energy_after = ledas::kinetic_energy(bodies, island.bodies);
-  stats_.kinetic_energy_change += energy_after - energy_before;
+  lane.stats.kinetic_energy_change += energy_after - energy_before;
   if (island.bouncing() && energy_after > energy_before * (1.0 + ledas::kRoundoff) + 1e-300)
-    ++counters.energy_gain_events;
-  report_island(island, bodies, contacts, counters);
-  if (island.frictional && settings_.warm_start) remember_impulses(island, contacts);
-  correct_positions(island, bodies);
-  ++counters.islands;
-  ++stats_.islands;
-  stats_.largest_island = std::max(stats_.largest_island, island.rows.size());
-  stats_.rounds = std::max(stats_.rounds, island.rounds);
+    ++lane.counters.energy_gain_events;
+  report_island(island, bodies, contacts, lane.counters);
+  if (island.frictional && settings_.warm_start) remember_impulses(lane, island, contacts);
+  correct_positions(island, bodies, lane);
+  ++lane.counters.islands;
+  ++lane.stats.islands;
+  lane.stats.largest_island = std::max(lane.stats.largest_island, island.rows.size());
+  lane.stats.rounds = std::max(lane.stats.rounds, island.rounds);
   for (BodyIndex body : island.bodies) body_slot_[body] = -1;
 }
 

@@ -1,6 +1,7 @@
 // The paper mode (sec. 3.2): rounds in which only the approaching rows enter, A_SS p = b_S is solved as
 // equalities, (1 + e) p applied, and every row re-checked, until none approaches.
 #include "island.hpp"
+#include "lane.hpp"
 #include "impetus/resolution/ledas/ledas.hpp"
 
 #include <algorithm>
@@ -247,9 +248,9 @@ class PaperRounds {
 
 }  // namespace
 
-void LedasResolver::velocity_paper(ledas::Island& island, std::span<RigidBody> bodies, ResolverCounters& counters) {
+void LedasResolver::velocity_paper(ledas::Island& island, std::span<RigidBody> bodies, Lane& lane) {
   island.velocity_current = false;  // the rounds keep their own velocities
-  PaperRounds(island, rows_, info_, settings_, solver_, stats_, bodies).run(counters);
+  PaperRounds(island, rows_, info_, settings_, lane.solver, lane.stats, bodies).run(lane.counters);
 }
 
 }  // namespace impetus

@@ -2,6 +2,7 @@
 // q ≥ 0 with A q ≥ target and complementarity move positions only.
 #include "impetus/resolution/common/resting.hpp"
 #include "island.hpp"
+#include "lane.hpp"
 #include "impetus/resolution/ledas/ledas.hpp"
 
 #include <algorithm>
@@ -20,7 +21,7 @@ constexpr double kPositionTolerance = 1e-12;
 // right-hand side; joint rows hold (target 0) so the correction does not drag them. Only along normals:
 // an island with friction leaves its tangent rows out (A restricted to the other rows), so the
 // correction never pushes a body along a slope.
-void LedasResolver::correct_positions(ledas::Island& island, std::span<RigidBody> bodies) {
+void LedasResolver::correct_positions(ledas::Island& island, std::span<RigidBody> bodies, Lane& lane) {
   std::vector<ledas::RowIndex> kept;  // local rows of the correction problem (all but tangent rows)
   ledas::SparseMatrix restricted;
   if (island.frictional) {
@@ -51,14 +52,14 @@ void LedasResolver::correct_positions(ledas::Island& island, std::span<RigidBody
     needed = needed || t > kPositionTolerance;
   }
   if (!needed) return;
-  const std::uint64_t refused_before = stats_.position.refused;
-  ledas::Vector q = solver_.solve_complementarity(problem, stats_.position);
+  const std::uint64_t refused_before = lane.stats.position.refused;
+  ledas::Vector q = lane.solver.solve_complementarity(problem, lane.stats.position);
   // No correction moves a body absurdly far (conflicting targets: a body pinned deep in the ground).
   std::vector<const resolution::ImpulseRow*> rows(m);
   for (std::size_t j = 0; j < m; ++j) rows[j] = &rows_[island.rows[local(j)]];
   const resolution::CorrectionBound bound = resolution::bound_correction(
       rows, std::span<double>(q.data(), m), resolution::kCorrectionBoundFactor * total_target, bodies);
-  bool clamped = bound.scale < 1.0 || stats_.position.refused > refused_before;  // refused: clamped to 0
+  bool clamped = bound.scale < 1.0 || lane.stats.position.refused > refused_before;  // refused: clamped to 0
   // Nor may it open a joint: the joint rows hold with target 0, so a consistent correction leaves them
   // shut to rounding; conflicting targets (a body pinned deep in the ground) would drag the joint apart
   // and hand the next velocity phase an impossible target. The correction is scaled down until no joint
@@ -77,8 +78,8 @@ void LedasResolver::correct_positions(ledas::Island& island, std::span<RigidBody
     largest *= scale;
     clamped = true;
   }
-  if (clamped) ++stats_.corrections_clamped;
-  stats_.largest_correction = std::max(stats_.largest_correction, largest);
+  if (clamped) ++lane.stats.corrections_clamped;
+  lane.stats.largest_correction = std::max(lane.stats.largest_correction, largest);
   for (std::size_t j = 0; j < m; ++j)
     if (const double qj = q(static_cast<Eigen::Index>(j)); qj != 0.0)
       resolution::apply_row_displacement(*rows[j], qj, bodies);

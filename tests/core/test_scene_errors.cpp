@@ -10,7 +10,7 @@ using test::load_error;
 
 TEST(SceneErrors, UnknownTopLevelKeyListsTheAllowedKeys) {
   expect_error("dt: 0.001\ngraviti: [0, 0, -9.81]\n",
-               "scene.yaml:2:1: unknown key 'graviti' in scene; expected one of: dt, gravity, step_order, sleep, "
+               "scene.yaml:2:1: unknown key 'graviti' in scene; expected one of: dt, gravity, step_order, sleep, threads, "
                "plugin_path, modules, bodies, generators, constraints; did you mean 'gravity'?");
 }
 

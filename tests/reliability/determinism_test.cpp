@@ -200,6 +200,31 @@ TEST(Determinism, GoldenHashPerResolver) {
               << table << std::flush;
 }
 
+// Threads (docs/conventions.md, "Threads"): islands solved in parallel (ledas) and the narrowphase split
+// across threads (fcl) give the same bits for 1, 2 and 4 threads, as Box2D tests its solver: one hash
+// for every thread count. Scenes with many islands and many pairs (several chunks of the narrowphase),
+// with and without friction; 2 and 4 threads on a 2-core machine still interleave the lanes differently.
+TEST(Determinism, SameHashForEveryThreadCount) {
+  const auto host = make_host();
+  for (const char* scene : {"friction_ramp", "resting_shapes", "billiards", "demo", "friction_card_house"}) {
+    std::uint64_t first = 0;
+    for (const char* threads : {"1", "2", "4"}) {
+      std::vector<SceneOverride> overrides = with_resolver("ledas");
+      overrides.push_back({"threads", threads});
+      const auto world = bundled_world(scene, *host, overrides);
+      ASSERT_EQ(world->threads(), static_cast<std::uint32_t>(std::stoi(threads)));
+      Fnv1a hash;
+      for (int step = 0; step < 150; ++step) {
+        const StepStatus& status = world->step();
+        ASSERT_TRUE(status.ok) << scene << " threads " << threads << ": " << status.message;
+        for (std::uint64_t word : state_bits(*world)) hash.add(word);
+      }
+      if (std::string(threads) == "1") first = hash.h;
+      EXPECT_EQ(hash.h, first) << scene << ": " << threads << " threads give another trajectory than 1";
+    }
+  }
+}
+
 // The hash itself is deterministic within one process: computing a case twice gives the same value.
 TEST(Determinism, GoldenHashRepeatsWithinOneProcess) {
   const auto host = make_host();

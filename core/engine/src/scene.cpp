@@ -48,8 +48,8 @@ Scene read_scene(const SceneReader& r, const YAML::Node& root) {
   if (!root.IsMap()) r.fail(root, "a scene is a mapping of keys (dt, gravity, modules, bodies, ...), got " +
                                       SceneReader::describe(root));
   const Fields f(r, root, "scene",
-                 {"dt", "gravity", "step_order", "sleep", "plugin_path", "modules", "bodies", "generators",
-                  "constraints"});
+                 {"dt", "gravity", "step_order", "sleep", "threads", "plugin_path", "modules", "bodies",
+                  "generators", "constraints"});
   Scene scene;
   if (const YAML::Node* n = f.find("dt")) scene.settings.dt = r.positive(*n, "dt");
   if (const YAML::Node* n = f.find("gravity")) scene.settings.gravity = r.vec3(*n, "gravity");
@@ -66,6 +66,9 @@ Scene read_scene(const SceneReader& r, const YAML::Node& root) {
     if (const YAML::Node* v = s.find("angular_velocity")) sleep.angular_velocity = r.non_negative(*v, "angular_velocity");
     if (const YAML::Node* v = s.find("time")) sleep.time = r.positive(*v, "time");
   }
+  // Threads the modules may use (docs/conventions.md, "Threads"): 0 for every core; results do not depend on it.
+  if (const YAML::Node* n = f.find("threads"))
+    scene.settings.threads = static_cast<std::uint32_t>(r.integer(*n, "threads", 0, World::kMaxThreads));
   if (const YAML::Node* n = f.find("plugin_path")) {
     // One directory or a list of them, relative to the scene file.
     const std::vector<YAML::Node> dirs = n->IsSequence() ? r.list(*n, "plugin_path") : std::vector{*n};

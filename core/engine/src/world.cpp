@@ -4,6 +4,8 @@
 #include "impetus/core/format.hpp"
 #include "impetus/engine/metrics.hpp"
 
+#include <tbb/task_arena.h>
+
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -152,9 +154,27 @@ World::World(WorldSettings settings) : settings_(std::move(settings)) {
     throw Error("world: sleep angular_velocity must be finite and >= 0, got " + format_number(sleep.angular_velocity));
   if (!(sleep.time > 0.0) || !std::isfinite(sleep.time))
     throw Error("world: sleep time must be positive and finite, got " + format_number(sleep.time));
+  set_threads(settings_.threads);
 }
 
 World::~World() = default;
+
+// The arena every module call of a step runs in: the modules' parallel loops (tbb::parallel_for) take
+// their threads from it, so `threads` bounds them all; its results never depend on how many there are.
+struct World::Threads {
+  explicit Threads(std::uint32_t n) : arena(n == 0 ? tbb::task_arena::automatic : static_cast<int>(n)) {}
+  tbb::task_arena arena;
+};
+
+void World::set_threads(std::uint32_t threads) {
+  if (threads > kMaxThreads)
+    throw Error("world: threads must be at most " + std::to_string(kMaxThreads) + " (0: every core), got " +
+                std::to_string(threads));
+  settings_.threads = threads;
+  threads_ = std::make_unique<Threads>(threads);
+}
+
+std::uint32_t World::threads() const { return static_cast<std::uint32_t>(threads_->arena.max_concurrency()); }
 
 void World::check_new_body(const RigidBody& body, std::size_t index) const {
   validate_body(body, index);
@@ -438,6 +458,11 @@ void World::move_prescribed() {
 }
 
 const StepStatus& World::step() {
+  threads_->arena.execute([this] { step_now(); });
+  return status_;
+}
+
+void World::step_now() {
   if (!integrator_) throw Error("world: no integrator set");
   for (std::size_t i = 0; i < bodies_.size(); ++i)
     if (const char* why = motion_problem(bodies_[i])) throw Error(body_label(bodies_[i], i) + ": " + why);
@@ -516,7 +541,6 @@ const StepStatus& World::step() {
   for (const RigidBody& b : bodies_)
     if (!b.fixed) ++(b.asleep ? status_.sleeping_bodies : status_.awake_bodies);
   status_.profile.total = seconds_since(start);
-  return status_;
 }
 
 // Sleeping bodies keep zero velocities: the velocity stage's kick from gravity is taken back before
@@ -638,8 +662,10 @@ const StepStatus& World::detect_and_resolve() {
   const auto start = Clock::now();
   status_ = StepStatus{};
   take_snapshot();
-  detect(status_);
-  resolve(status_);
+  threads_->arena.execute([this] {
+    detect(status_);
+    resolve(status_);
+  });
   check_finite(status_, "resolution");
   status_.profile.total = seconds_since(start);
   return status_;
@@ -648,7 +674,7 @@ const StepStatus& World::detect_and_resolve() {
 const StepStatus& World::detect_contacts() {
   const auto start = Clock::now();
   status_ = StepStatus{};
-  detect(status_);
+  threads_->arena.execute([this] { detect(status_); });
   status_.profile.total = seconds_since(start);
   return status_;
 }

@@ -5,6 +5,7 @@
 
 #include "impetus/core/math.hpp"
 
+#include <algorithm>
 #include <cstdint>
 
 namespace impetus {
@@ -73,5 +74,28 @@ struct ResolverCounters {
   std::uint64_t corrections_clamped = 0;
   double largest_correction = 0.0;     ///< largest displacement a position correction gave a body (m)
 };
+
+/// Adds the counters of a part of a step (one thread's islands, say) to `into`: counts and work add up,
+/// the largest values stay the largest. Adding parts in a fixed order gives the same sums every time.
+inline void add(ResolverCounters& into, const ResolverCounters& part) {
+  into.islands += part.islands;
+  into.contacts += part.contacts;
+  into.rounds += part.rounds;
+  into.pulling_impulses += part.pulling_impulses;
+  into.non_converged += part.non_converged;
+  into.singular_systems += part.singular_systems;
+  into.redundant_systems += part.redundant_systems;
+  into.nan_caught += part.nan_caught;
+  into.residual = std::max(into.residual, part.residual);
+  into.complementarity_error = std::max(into.complementarity_error, part.complementarity_error);
+  into.energy_gain_events += part.energy_gain_events;
+  into.sticking += part.sticking;
+  into.sliding += part.sliding;
+  into.natural_map_residual = std::max(into.natural_map_residual, part.natural_map_residual);
+  into.friction_work += part.friction_work;
+  into.work_limited += part.work_limited;
+  into.corrections_clamped += part.corrections_clamped;
+  into.largest_correction = std::max(into.largest_correction, part.largest_correction);
+}
 
 }  // namespace impetus

@@ -45,6 +45,10 @@ struct WorldSettings {
   Vec3 gravity{0.0, 0.0, -9.81};          ///< m/s²
   StepOrder order = StepOrder::split;
   SleepSettings sleep;
+  /// Threads the modules may use within a step (docs/conventions.md, "Threads"): 0 (default) for every
+  /// core of the machine (as many as the process may run on), 1 for none but the caller's. The
+  /// trajectories are bit-identical for every value.
+  std::uint32_t threads = 0;
 };
 
 /// Wall time of each stage of one step (seconds, steady clock).
@@ -153,6 +157,11 @@ class World {
   /// Contacts found by the last detection, with the impulses of the last resolution.
   const std::vector<Contact>& contacts() const { return contacts_; }
   const WorldSettings& settings() const { return settings_; }
+  /// Sets how many threads the modules may use from the next step on (0: every core; see
+  /// WorldSettings::threads); the trajectory does not change.
+  void set_threads(std::uint32_t threads);
+  /// How many threads the modules may use (WorldSettings::threads with 0 replaced by the core count).
+  std::uint32_t threads() const;
   const StepStatus& last_status() const { return status_; }
   double time() const { return time_; }
   std::uint64_t step_count() const { return step_count_; }
@@ -162,7 +171,11 @@ class World {
   bool has_detector() const { return detector_ != nullptr; }
   bool has_resolver() const { return resolver_ != nullptr; }
 
+ /// The most threads a world may be given.
+  static constexpr std::uint32_t kMaxThreads = 4096;
+
  private:
+  void step_now();  // step() inside the thread arena
   StepContext context() const;
   void detect(StepStatus& status);
   void resolve(StepStatus& status);
@@ -188,7 +201,10 @@ class World {
     Vec3 angular_velocity;
   };
 
+  struct Threads;  // the thread arena the modules' parallel loops run in (world.cpp, oneTBB)
+
   WorldSettings settings_;
+  std::unique_ptr<Threads> threads_;
   std::vector<RigidBody> bodies_;
   std::vector<BodyHandle> handles_;  // per body, increasing (removal keeps the order)
   std::uint64_t next_handle_ = 1;

@@ -106,6 +106,9 @@ struct FrictionalStats {
   double residual = 0.0;               ///< largest natural-map residual returned
 };
 
+/// Adds the counts of `part` to `into` (the residual: the larger).
+void add(FrictionalStats& into, const FrictionalStats& part);
+
 /// The natural-map residual of `r` (fclib's error without its scaling): the 2-norm over rows of
 /// r − P_K(r − (u + μ‖u_t‖ e_n)) for frictional contacts, r − max(0, r − u) for frictionless ones and u
 /// for joint rows, with u = W r + q.

@@ -82,6 +82,9 @@ struct SolverStats {
   std::uint64_t sharpened = 0;    ///< refinements that refactored at a smaller shift (fewer steps)
 };
 
+/// Adds the counts of `part` to `into`.
+void add(SolverStats& into, const SolverStats& part);
+
 /// One island's complementarity problem: find p with w = A p − c and
 ///   equality rows: w = 0, p free;   the other rows: p ≥ 0, w ≥ −tolerance, p·w = 0.
 /// For the velocity phase p are impulses (N·s), c = target − v_n⁻ and w = v_n⁺ − target (m/s).

@@ -22,6 +22,7 @@
 #include <compare>
 #include <cstdint>
 #include <map>
+#include <memory>
 #include <vector>
 
 namespace impetus {
@@ -50,6 +51,10 @@ struct LedasStats {
   std::uint64_t duplicate_constraints = 0;
   double largest_correction = 0.0;  ///< largest displacement a position correction gave a row point (m)
 };
+
+/// Adds the statistics of `part` (some islands of a resolve) to `into`: counts and the energy change add
+/// up, the largest values stay the largest.
+void add(LedasStats& into, const LedasStats& part);
 
 /// The LEDAS resolver: contacts and assembly constraints (point-point, coaxial) in one system per island.
 ///
@@ -83,6 +88,7 @@ class LedasResolver final : public CollisionResolver {
   explicit LedasResolver(const ModuleOptions& options);
   /// Builds the resolver from settings directly (tests, embedding).
   explicit LedasResolver(const LedasSettings& settings = {});
+  ~LedasResolver() override;
 
   /// Accepts point-point and coaxial constraints at either level; refuses one with a bad axis or length.
   ModuleStatus accept_constraints(std::span<const Constraint> constraints) noexcept override;
@@ -107,6 +113,14 @@ class LedasResolver final : public CollisionResolver {
   const LedasStats& last_stats() const { return stats_; }
 
  private:
+  // One worker's solvers, statistics and scratch (lane.hpp). The islands of a step are dealt to the
+  // lanes by their index (island i to lane i mod kLanes) and the lanes run in parallel, each on its
+  // islands in order; a lane's caches (symbolic analyses) thus see the same islands in the same order
+  // whatever the number of threads, and the lanes' statistics are added up in lane order, so the results
+  // are bit-identical for every thread count.
+  struct Lane;
+  static constexpr std::size_t kLanes = 64;
+
   // The stages of one resolve(), each in its own file: ledas.cpp (rows, islands, report), island.cpp
   // (an island's system), paper_rounds.cpp, complementary_impact.cpp, restitution.cpp,
   // position_correction.cpp.
@@ -115,34 +129,36 @@ class LedasResolver final : public CollisionResolver {
   void build_rows(std::span<const RigidBody> bodies, std::span<Contact> contacts,
                   std::span<const Constraint> constraints, double dt, ResolverCounters& counters);
   void solve_island(std::vector<std::uint32_t> rows, std::span<RigidBody> bodies, std::span<Contact> contacts,
-                    double dt, ResolverCounters& counters);
+                    double dt, Lane& lane);
   ledas::Island make_island(std::vector<std::uint32_t> rows, std::span<const RigidBody> bodies, double dt);
   void assign_restitution(ledas::Island& island, std::span<const RigidBody> bodies);
   const ledas::Vector& current_velocities(ledas::Island& island, std::span<const RigidBody> bodies) const;
-  void velocity_paper(ledas::Island& island, std::span<RigidBody> bodies, ResolverCounters& counters);
-  void velocity_complementary(ledas::Island& island, std::span<RigidBody> bodies, ResolverCounters& counters);
-  void velocity_frictional(ledas::Island& island, std::span<RigidBody> bodies, ResolverCounters& counters);
-  ledas::Vector solve_frictional(ledas::Island& island, const ledas::Vector& q, const ledas::Vector* start = nullptr);
+  void velocity_paper(ledas::Island& island, std::span<RigidBody> bodies, Lane& lane);
+  void velocity_complementary(ledas::Island& island, std::span<RigidBody> bodies, Lane& lane);
+  void velocity_frictional(ledas::Island& island, std::span<RigidBody> bodies, Lane& lane);
+  ledas::Vector solve_frictional(Lane& lane, ledas::Island& island, const ledas::Vector& q,
+                                 const ledas::Vector* start = nullptr);
   ledas::Vector warm_start(const ledas::Island& island) const;
-  void remember_impulses(const ledas::Island& island, std::span<const Contact> contacts);
+  void remember_impulses(Lane& lane, const ledas::Island& island, std::span<const Contact> contacts) const;
   void apply_island_impulse(ledas::Island& island, const ledas::Vector& p, std::span<RigidBody> bodies,
-                            ResolverCounters& counters);
-  void narrow_start_set(const ledas::Island& island, const ledas::Vector& v, std::vector<char>& start);
+                            Lane& lane);
+  void narrow_start_set(Lane& lane, const ledas::Island& island, const ledas::Vector& v, std::vector<char>& start);
   void finish_round(ledas::Island& island, const ledas::Vector& p, const ledas::Vector& target,
                     std::span<RigidBody> bodies);
   void report_island(ledas::Island& island, std::span<const RigidBody> bodies, std::span<Contact> contacts,
                      ResolverCounters& counters);
-  void correct_positions(ledas::Island& island, std::span<RigidBody> bodies);
+  void correct_positions(ledas::Island& island, std::span<RigidBody> bodies, Lane& lane);
+  Lane& lane(std::size_t index);
 
   LedasSettings settings_;
-  ledas::IslandSolver solver_;
-  ledas::FrictionalSolver friction_solver_;
+  ledas::SolverSettings solver_settings_;     // the lanes' island solvers'
+  std::vector<std::unique_ptr<Lane>> lanes_;  // created when first used
+  ledas::FrictionalSolver friction_solver_;   // solve_contact_problem's
   LedasStats stats_;
   std::vector<resolution::ImpulseRow> rows_;  // this step's rows: contacts first, then joint rows
   std::vector<ledas::RowInfo> info_;
   resolution::InverseInertiaCache inertia_;  // the bodies' J⁻¹ while this step's rows are built
-  std::vector<std::int32_t> body_slot_;  // per body: its slot in the current island's movable bodies, or −1
-  std::vector<std::int32_t> hops_, queue_;  // narrow_start_set's distances and search queue (reused)
+  std::vector<std::int32_t> body_slot_;  // per body: its slot in its island's movable bodies, or −1
   // Warm starts: a frictional contact's inelastic impulse (normal; tangential as a world vector) by its
   // bodies and feature key, from the last step (`warm_`) and for the next (`next_warm_`); per row of
   // this step, the warm start found for it (0 if none).

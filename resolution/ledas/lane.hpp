@@ -1,0 +1,27 @@
+#pragma once
+/// \file
+/// One worker's share of a resolve() (private: not installed): the solvers with their caches of symbolic
+/// analyses, the statistics and counters of the islands it solved, its scratch, and the warm starts it
+/// keeps for the next step. The lanes of a step run in parallel; what one lane computes depends only on
+/// the islands dealt to it (ledas.hpp, LedasResolver::kLanes), never on which thread runs it.
+
+#include "impetus/resolution/ledas/ledas.hpp"
+
+#include <cstdint>
+#include <utility>
+#include <vector>
+
+namespace impetus {
+
+struct LedasResolver::Lane {
+  explicit Lane(const ledas::SolverSettings& settings) : solver(settings) {}
+
+  ledas::IslandSolver solver;
+  ledas::FrictionalSolver friction;
+  LedasStats stats;            // this step's, added into the resolver's in lane order
+  ResolverCounters counters;   // likewise
+  std::vector<std::int32_t> hops, queue;  // narrow_start_set's distances and search queue (reused)
+  std::vector<std::pair<ContactKey, ContactImpulse>> remembered;  // next step's warm starts, island order
+};
+
+}  // namespace impetus
