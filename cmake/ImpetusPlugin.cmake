@@ -1,13 +1,19 @@
-# impetus_add_plugin(<kind> <name> SOURCES <files...> [LIBRARIES <targets...>])
+# impetus_add_plugin(<kind> <name> SOURCES <files...> [LIBRARIES <targets...>] [STAYS_LOADED])
 #
 # Declares a module plugin in one line. <kind> is integrator, detector or resolver; <name> is the name a
 # scene uses. Builds the shared library impetus_<kind>_<name>.so (no "lib" prefix) into the plugin
 # directory the host searches, with hidden visibility (only the entry symbol is exported), and installs
 # it next to the core library. The target is named impetus_<kind>_<name>.
+#
+# STAYS_LOADED links the plugin with -z nodelete: dlclose then leaves it (and the libraries it pulled in)
+# mapped until the process exits. A plugin needs it when it starts threads that outlive a call, such as
+# oneTBB's worker pool: in a program that does not link that library itself (the plugin host alone, a
+# conformance test), the last module's dlclose would otherwise unmap the library under its sleeping
+# workers, and the process would crash later, at a time that depends on the scheduler.
 include_guard(GLOBAL)
 
 function(impetus_add_plugin kind name)
-  cmake_parse_arguments(ARG "" "" "SOURCES;LIBRARIES" ${ARGN})
+  cmake_parse_arguments(ARG "STAYS_LOADED" "" "SOURCES;LIBRARIES" ${ARGN})
   if(NOT kind MATCHES "^(integrator|detector|resolver)$")
     message(FATAL_ERROR "impetus_add_plugin: kind must be integrator, detector or resolver, got '${kind}'")
   endif()
@@ -32,6 +38,9 @@ function(impetus_add_plugin kind name)
   file(CONFIGURE OUTPUT "${exports}" CONTENT "{ global: impetus_plugin_descriptor; local: *; };\n")
   target_link_options(${target} PRIVATE "LINKER:--version-script=${exports}")
   set_property(TARGET ${target} APPEND PROPERTY LINK_DEPENDS "${exports}")
+  if(ARG_STAYS_LOADED)
+    target_link_options(${target} PRIVATE "LINKER:-z,nodelete")
+  endif()
   if(DEFINED IMPETUS_PLUGIN_OUTPUT_DIRECTORY)
     set_target_properties(${target} PROPERTIES LIBRARY_OUTPUT_DIRECTORY "${IMPETUS_PLUGIN_OUTPUT_DIRECTORY}")
   endif()

@@ -1,5 +1,6 @@
 // The success path: a module is created, runs the plugin's code, keeps its library loaded for as long as
-// it lives (even after the host is gone), and the library is unloaded after the last module goes.
+// it lives (even after the host is gone), and the library is unloaded after the last module goes, unless
+// it was built to stay loaded.
 #include "plugin_test_support.hpp"
 
 #include <memory>
@@ -49,6 +50,32 @@ TEST(PluginLoad, ModuleOutlivesTheHostAndTheLibraryIsUnloadedAfterIt) {
   expect_fixture_good_runs(*integrator, 1.0);
   integrator.reset();
   EXPECT_FALSE(is_loaded(file)) << "the last module released its library";
+}
+
+TEST(PluginLoad, ShippedPluginsWithAThreadPoolStayLoadedAfterTheirLastModule) {
+  // fcl and ledas run oneTBB's workers, which outlive the call that started them: their libraries are
+  // built STAYS_LOADED (-z nodelete), so releasing the last module must leave them mapped (plugins/README.md).
+  // mirtich starts no thread and is unloaded as usual.
+  auto host = host_with({});
+  const fs::path dir(IMPETUS_PLUGIN_DIR);
+  impetus::PluginRequest request;
+  request.kind = impetus::ModuleKind::detector;
+  request.name = "fcl";
+  auto detector = host.create_detector(request);
+  ASSERT_NE(detector, nullptr);
+  request.kind = impetus::ModuleKind::resolver;
+  request.name = "ledas";
+  auto ledas = host.create_resolver(request);
+  ASSERT_NE(ledas, nullptr);
+  request.name = "mirtich";
+  auto mirtich = host.create_resolver(request);
+  ASSERT_NE(mirtich, nullptr);
+  detector.reset();
+  ledas.reset();
+  mirtich.reset();
+  EXPECT_TRUE(is_loaded(dir / "impetus_detector_fcl.so"));
+  EXPECT_TRUE(is_loaded(dir / "impetus_resolver_ledas.so"));
+  EXPECT_FALSE(is_loaded(dir / "impetus_resolver_mirtich.so"));
 }
 
 TEST(PluginLoad, ModulesOfOneLibraryShareIt) {
