@@ -13,6 +13,7 @@
 // counters add natural_map (ledas's natural-map residual), sticking and sliding. The walls of 200 and
 // 1,000 bricks (25 per course) run only with IMPETUS_BENCH_SLOW=1: one step of the 200-brick wall takes
 // ledas 10-140 s today (benchmarks/README.md), so the default suite would not finish.
+#include "support/bench_dynamic.hpp"
 #include "support/bench_main.hpp"
 #include "support/bench_resolvers.hpp"
 #include "support/bench_scenes.hpp"
@@ -24,7 +25,9 @@
 
 #include <benchmark/benchmark.h>
 
+#include <algorithm>
 #include <cstdlib>
+#include <map>
 #include <memory>
 #include <string>
 #include <vector>
@@ -119,6 +122,98 @@ void step(benchmark::State& state, const std::string& resolver_name, Scene scene
   }
 }
 
+// The dynamic scenes (support/bench_dynamic.hpp). Every iteration restores the scene's snapshot (untimed)
+// and times kDynamicSteps whole steps from it, so the contact pattern changes from step to step as in a
+// running simulation; the resolver keeps what it learnt in the previous iteration, as it would from the
+// previous step. Counters are per step: step_ms and the stages, contacts, islands, rounds; residual,
+// natural_map and penetration (deepest contact a detection found) are the largest over the steps, and
+// energy_change the kinetic energy the resolve stage changed per step (J).
+constexpr int kDynamicSteps = 5;
+
+const std::vector<RigidBody>& snapshot(const std::string& family, int n, double mu) {
+  static std::map<std::string, std::vector<RigidBody>> cache;
+  const std::string key = family + "_" + std::to_string(n) + "_" + std::to_string(mu);
+  auto it = cache.find(key);
+  if (it == cache.end()) it = cache.emplace(key, bench::dynamic_snapshot(bench::dynamic_scene(family, n, mu))).first;
+  return it->second;
+}
+
+void dynamic_step(benchmark::State& state, const std::string& resolver_name, const std::string& family, int n,
+                  double mu, std::uint32_t threads) {
+  const std::vector<RigidBody>& start = snapshot(family, n, mu);
+  World world;
+  bench::set_up_world(world, start);
+  world.set_resolver(bench::make_resolver(resolver_name, /*velocity_only=*/false));
+  world.set_threads(threads);
+  StepProfile sum;
+  double contacts = 0, islands = 0, rounds = 0, energy = 0, residual = 0, natural_map = 0, penetration = 0;
+  for (auto _ : state) {
+    state.PauseTiming();
+    bench::restore_state(world.bodies(), start);
+    state.ResumeTiming();
+    for (int i = 0; i < kDynamicSteps; ++i) {
+      const StepStatus& s = world.step();
+      state.PauseTiming();
+      if (!s.ok) {
+        state.SkipWithError(s.message.c_str());
+        return;
+      }
+      sum.velocities += s.profile.velocities;
+      sum.detect += s.profile.detect;
+      sum.resolve += s.profile.resolve;
+      sum.positions += s.profile.positions;
+      sum.total += s.profile.total;
+      contacts += static_cast<double>(s.detector.contacts);
+      islands += static_cast<double>(s.resolver.islands);
+      rounds += static_cast<double>(s.resolver.rounds);
+      energy += s.resolve_kinetic_energy_change;
+      residual = std::max(residual, s.resolver.residual);
+      natural_map = std::max(natural_map, s.resolver.natural_map_residual);
+      for (const Contact& c : world.contacts()) penetration = std::max(penetration, c.depth);
+      state.ResumeTiming();
+    }
+  }
+  const auto per_step = [](double total) { return benchmark::Counter(total / kDynamicSteps, benchmark::Counter::kAvgIterations); };
+  state.counters["bodies"] = static_cast<double>(std::count_if(start.begin(), start.end(), [](const RigidBody& b) { return !b.fixed; }));
+  state.counters["threads"] = static_cast<double>(world.threads());
+  state.counters["step_ms"] = per_step(1e3 * sum.total);
+  state.counters["detect_ms"] = per_step(1e3 * sum.detect);
+  state.counters["resolve_ms"] = per_step(1e3 * sum.resolve);
+  state.counters["contacts"] = per_step(contacts);
+  state.counters["islands"] = per_step(islands);
+  state.counters["rounds"] = per_step(rounds);
+  state.counters["energy_change"] = per_step(energy);
+  state.counters["residual"] = residual;
+  state.counters["penetration"] = penetration;
+  if (resolver_name.starts_with("ledas") && mu > 0) state.counters["natural_map"] = natural_map;
+}
+
+void register_dynamic(long max_bodies) {
+  struct Row {
+    const char* family;
+    int n;
+    double mu;
+  };
+  const Row rows[] = {{"pile", 100, 0.0},   {"pile", 1000, 0.0},  {"pile", 1000, 0.5},
+                      {"heap", 1000, 0.0},  {"heap", 10000, 0.0}, {"heap", 1000, 0.5},
+                      {"knocked_wall", 200, 0.0}, {"knocked_wall", 1000, 0.0}};
+  const bool slow = std::getenv("IMPETUS_BENCH_SLOW") != nullptr;
+  for (const Row& row : rows) {
+    // The knocked wall of 1,000 bricks is one island of ~11,600 contacts whose active set ledas builds
+    // over thousands of pivots: minutes per step today (benchmarks/README.md), so only with IMPETUS_BENCH_SLOW.
+    if (row.n > max_bodies || (row.family == std::string("knocked_wall") && row.n >= 1000 && !slow)) continue;
+    const std::string scene = std::string(row.family) + "_" + std::to_string(row.n) + (row.mu > 0 ? "_mu0.5" : "");
+    for (const std::string resolver : {"ledas", "mirtich"})
+      for (std::uint32_t threads : {1u, 2u}) {
+        if (resolver == "mirtich" && threads > 1) continue;  // mirtich is serial; only the detector would split
+        const std::string name = "step/" + resolver + "/" + scene + "_t" + std::to_string(threads);
+        benchmark::RegisterBenchmark(name.c_str(), [=](benchmark::State& st) {
+          dynamic_step(st, resolver, row.family, row.n, row.mu, threads);
+        })->Unit(benchmark::kMillisecond);
+      }
+  }
+}
+
 int register_all() {
   const char* cap = std::getenv("IMPETUS_BENCH_MAX_BODIES");
   const long max_bodies = cap ? std::atol(cap) : 1L << 40;
@@ -172,6 +267,7 @@ int register_all() {
       }
     }
   }
+  register_dynamic(max_bodies);
   return 0;
 }
 const int registered = register_all();

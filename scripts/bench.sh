@@ -21,22 +21,26 @@ if [ $quick = 1 ]; then
   reps=3
   export IMPETUS_BENCH_MAX_BODIES=210
 fi
-run() {  # run NAME [extra args]: bench_NAME → docs/data/NAME.json
-  local name=$1; shift
-  echo "== bench_$name"
+run_as() {  # run_as OUT NAME [extra args]: bench_NAME → docs/data/OUT.json
+  local out=$1 name=$2; shift 2
+  echo "== bench_$name → $out.json"
   "$build/bin/bench_$name" --benchmark_repetitions=$reps --benchmark_report_aggregates_only=true \
     --benchmark_min_time=0.1 --benchmark_format=console --benchmark_out_format=json \
-    --benchmark_out="$data/$name.json" --benchmark_context=impetus_build_type=RelWithDebInfo "$@"
+    --benchmark_out="$data/$out.json" --benchmark_context=impetus_build_type=RelWithDebInfo "$@"
 }
+run() { run_as "$1" "$@"; }  # run NAME [extra args]: bench_NAME → docs/data/NAME.json
 run resolve
-run step
+# The dynamic scenes' rows (…_t1, …_t2) go to their own file: they run long (a 10,000-sphere heap).
+run step --benchmark_filter='-_t[0-9]+$'
+run_as dynamic step --benchmark_filter='_t[0-9]+$'
 run detect
 run model
 if [ -x "$build/bin/bench_peers" ]; then
-  run peers
+  run peers --benchmark_filter='-/heap_'
+  run_as dynamic_peers peers --benchmark_filter='/heap_'
   mkdir -p "$root/docs/charts"
   "$py" "$root/benchmarks/peers/report.py" "$data/peers.json" --chart "$root/docs/charts/peers.png" > "$root/docs/peers.md"
-else rm -f "$data/peers.json"; echo "== bench_peers not built (no Bullet/ODE/MuJoCo): skipped"; fi
+else rm -f "$data/peers.json" "$data/dynamic_peers.json"; echo "== bench_peers not built (no Bullet/ODE/MuJoCo): skipped"; fi
 "$py" "$root/scripts/bench_report.py" "$data" "$root/docs"
 # Frictional contact problems in fclib's form (generated and exported; a table and a performance profile).
 run fclib

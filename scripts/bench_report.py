@@ -4,7 +4,8 @@
 Usage: bench_report.py DATA_DIR DOCS_DIR
 
 DATA_DIR holds Google Benchmark JSON files (--benchmark_format=json): resolve.json, step.json,
-detect.json and, when the peers benchmark was built, peers.json. Medians are used where the run had
+detect.json, dynamic.json (bench_step's dynamic rows) and, when the peers benchmark was built, peers.json
+and dynamic_peers.json (its rows on the dynamic heap). Medians are used where the run had
 repetitions (aggregate "median"), else the single run. Writes DOCS_DIR/benchmarks.md and
 DOCS_DIR/charts/scaling.{png,svg} (and peers.{png,svg} with peers.json). Charts need matplotlib; without
 it the tables are still written and the charts are skipped with a message.
@@ -263,6 +264,44 @@ def peers_table(rows, scene_wanted):
     return "\n".join(lines)
 
 
+def dynamic_table(rows):
+    """bench_step's dynamic rows, step/<resolver>/<scene>_t<threads>: per-step wall times (the world's step
+    profile, steady clock: CPU time would miss the second thread) and the speed-up of 2 threads over 1."""
+    by_key = {}
+    for name, row in rows.items():
+        m = re.match(r"step/([a-z_]+)/(.+)_t(\d+)$", name)
+        if m and "error" not in row:
+            by_key[(m.group(2), m.group(1), int(m.group(3)))] = row
+    lines = ["| Scene | Resolver | Threads | Bodies | Contacts | Islands | Step (median) | detect | resolve | "
+             "2 threads over 1 | Residual (m/s) | Natural map | Deepest (m) |",
+             "|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|"]
+    for (scene, resolver, threads), row in sorted(by_key.items()):
+        one = by_key.get((scene, resolver, 1))
+        ratio = f"{one['step_ms'] / row['step_ms']:.2f}×" if threads == 2 and one else ""
+        ms = lambda k: seconds(row[k] * 1e-3)
+        lines.append(f"| {scene} | {resolver} | {threads} | {row['bodies']:.0f} | {row['contacts']:.0f} | "
+                     f"{row['islands']:.0f} | {ms('step_ms')} | {ms('detect_ms')} | {ms('resolve_ms')} | {ratio} | "
+                     f"{sci(row.get('residual'))} | {sci(row.get('natural_map'))} | {sci(row.get('penetration'))} |")
+    return "\n".join(lines)
+
+
+def dynamic_peers_table(rows):
+    """bench_peers' rows on the dynamic heap: one whole step under gravity from its snapshot per engine."""
+    entries = []
+    for name, row in rows.items():
+        parts = name.split("/")
+        if len(parts) == 3 and parts[2].startswith("heap_") and "error" not in row:
+            entries.append((int(parts[2].split("_")[1]), row["seconds"], parts[1].removesuffix("_gravity"), row))
+    entries.sort()
+    lines = ["| Heap | Method | Step (median) | Solver alone | Contacts found | Touching contacts missed | "
+             "Residual (m/s) | Complementarity |", "|---:|---|---:|---:|---:|---:|---:|---:|"]
+    for n, _, method, row in entries:
+        solver = seconds(row["solver_ms"] * 1e-3) if row.get("solver_ms") else "—"
+        lines.append(f"| {n} | {method} | {seconds(row['seconds'])} | {solver} | {row['engine_contacts']:.0f} | "
+                     f"{row['missing']:.0f} | {sci(row.get('residual'))} | {sci(row.get('complementarity'))} |")
+    return "\n".join(lines)
+
+
 def charts(res, out_dir):
     try:
         import matplotlib
@@ -346,11 +385,29 @@ def main():
                 "Detect + resolve + integrate from the drop/push state, position correction on; the stage split "
                 "comes from the world's step profile.", "",
                 step_table(by_scene(step["rows"], "step")), ""]
+    dynamic = load(os.path.join(data_dir, "dynamic.json"))
+    dynamic_peers = load(os.path.join(data_dir, "dynamic_peers.json"))
+    if dynamic:
+        out += ["## Dynamic scenes (`step` family, rows `…_t1`, `…_t2`)", "",
+                "Scenes whose contact pattern changes almost every step (`benchmarks/support/bench_dynamic.hpp`): "
+                "a pile of mixed spheres, boxes and capsules poured into a bin, a heap of spheres settling on open "
+                "ground, a brick wall hit by a heavy ball. Each iteration restores the scene's snapshot and times "
+                "5 whole steps from it; the figures are per step, wall time, with 1 and 2 threads "
+                "(`World::set_threads`). *Residual* and *natural map* are the resolver's own, the largest over "
+                "the steps; *deepest* the deepest contact a detection found.", "",
+                dynamic_table(dynamic["rows"]), ""]
+    if dynamic_peers:
+        out += ["### The heap in every engine", "",
+                "One whole step under gravity from the heap's snapshot, each engine with its own detection "
+                "(Impetus on one thread, as the others); judged at the contacts that touch in the snapshot. An "
+                "engine's step includes rebuilding its contact cache after the benchmark's reset of every body, "
+                "which a running simulation does not pay: *solver alone* is the fairer comparison of the solves.", "",
+                dynamic_peers_table(dynamic_peers["rows"]), ""]
     if detect:
         out += ["## Detection alone (`detect` family)", "", detect_table(detect["rows"]), ""]
     if model:
         out += ["## Model no more than a scene needs (`model` family)", "",
-                "Each lever of "model no more than a scene needs" (docs/architecture.md) switched on and off on the same scene; one whole step from the "
+                "Each lever of “model no more than a scene needs” (docs/architecture.md) switched on and off on the same scene; one whole step from the "
                 "same state per iteration (`benchmarks/model.cpp`).", "", model_table(model["rows"]), ""]
     if peers:
         out += ["## Peers side by side (`peers` benchmark)", "",

@@ -1,9 +1,13 @@
 // Impetus's own resolvers in the peers table, run exactly as benchmarks/resolve.cpp runs them: the resolver
 // alone on the prepared contact list (detection done once, outside the timed step), position correction
-// off, velocities restored before every step.
+// off, velocities restored before every step. And, for the rows under gravity, Impetus's whole step as
+// bench_step runs it (momentum integrator, fcl, the resolver with its defaults), timed like an engine's.
 #include "peers.hpp"
 
+#include "support/bench_dynamic.hpp"
 #include "support/bench_resolvers.hpp"
+
+#include "impetus/engine/world.hpp"
 
 namespace impetus::peers {
 namespace {
@@ -43,6 +47,48 @@ class ImpetusStep final : public PeerStep {
   ResolverCounters counters_;
 };
 
+/// One whole World::step from the scene's state, the world's own detection included; the impulses are
+/// tallied onto the prepared contacts by pair, as an engine's are.
+class ImpetusWholeStep final : public PeerStep {
+ public:
+  ImpetusWholeStep(const bench::PreparedScene& scene, const StepSettings& settings, const std::string& resolver)
+      : scene_(scene), pairs_(scene.contacts), world_(world_settings(settings)) {
+    bench::set_up_world(world_, scene.bodies);
+    world_.set_resolver(bench::make_resolver(resolver, /*velocity_only=*/false));
+  }
+
+  void reset() override { bench::restore_state(world_.bodies(), scene_.bodies); }
+  void step() override { last_ = world_.step(); }
+
+  StepResult result() override {
+    StepResult r;
+    for (const RigidBody& b : world_.bodies()) {
+      r.velocity.push_back(b.velocity);
+      r.angular_velocity.push_back(b.angular_velocity);
+    }
+    ContactTally tally(pairs_, scene_.contacts.size(), true);
+    for (const Contact& c : world_.contacts()) tally.add(c.a, c.b, c.impulse);
+    tally.finish(r);
+    r.iterations = static_cast<double>(last_.resolver.rounds);
+    r.failures = static_cast<double>(last_.resolver.non_converged);
+    r.solver_seconds = last_.profile.resolve;
+    return r;
+  }
+
+ private:
+  static WorldSettings world_settings(const StepSettings& s) {
+    WorldSettings w;
+    w.dt = s.dt;
+    w.gravity = s.gravity;
+    w.threads = 1;  // per core, as the engines it is compared with
+    return w;
+  }
+  const bench::PreparedScene& scene_;
+  PairIndex pairs_;
+  World world_;
+  StepStatus last_;
+};
+
 }  // namespace
 
 void add_impetus_methods(std::vector<Method>& out) {
@@ -55,6 +101,14 @@ void add_impetus_methods(std::vector<Method>& out) {
       return std::make_unique<ImpetusStep>(scene, resolver);
     };
     out.push_back(std::move(m));
+    if (resolver == "ledas_paper") continue;
+    Method whole;
+    whole.name = "impetus_" + resolver + "_step";
+    whole.gravity_only = true;
+    whole.make = [resolver](const bench::PreparedScene& scene, const StepSettings& settings) {
+      return std::make_unique<ImpetusWholeStep>(scene, settings, resolver);
+    };
+    out.push_back(std::move(whole));
   }
 }
 

@@ -62,6 +62,8 @@ struct Method {
   bool restitution = true;
   /// Largest scene (movable bodies) this method is run on; dense direct solvers grow as n³.
   std::size_t max_bodies = std::size_t(1) << 40;
+  /// true: a whole Impetus step (detection, resolve, integration), run only on the rows under gravity.
+  bool gravity_only = false;
   std::function<std::unique_ptr<PeerStep>(const bench::PreparedScene&, const StepSettings&)> make;
 };
 

@@ -80,6 +80,50 @@ AxisResult box_box_axis(const Placed& a, const Placed& b) {
   return edge.valid && edge.overlap < face.overlap - bias ? edge : face;
 }
 
+AxisResult capsule_box_axis(const Placed& a, const Placed& b) {
+  const bool capsule_is_a = a.kind() == ShapeKind::capsule;
+  const Placed& capsule = capsule_is_a ? a : b;
+  const Placed& box = capsule_is_a ? b : a;
+  const Vec3& h = box.geometry->half_extents;
+  // The capsule's core segment p(t) = p0 + t·(p1 − p0), t ∈ [0, 1], in the box frame.
+  Vec3 w0, w1;
+  core_segment(capsule, w0, w1);
+  const Vec3 p0 = box.R.transpose() * (w0 - box.x), d = box.R.transpose() * (w1 - w0);
+  // Its squared distance to the box, |p(t) − clamp(p(t))|², is convex in t: golden-section search, a
+  // fixed number of steps (deterministic), to the width of rounding in t.
+  const auto gap = [&](double t) {
+    const Vec3 p = p0 + t * d;
+    return (p - p.cwiseMax(-h).cwiseMin(h)).squaredNorm();
+  };
+  constexpr double kInv = 0.6180339887498949;  // (√5 − 1)/2
+  double lo = 0.0, hi = 1.0, t1 = hi - kInv, t2 = lo + kInv, g1 = gap(t1), g2 = gap(t2);
+  for (int i = 0; i < 80; ++i) {
+    if (g1 <= g2) {
+      hi = t2, t2 = t1, g2 = g1, t1 = hi - kInv * (hi - lo), g1 = gap(t1);
+    } else {
+      lo = t1, t1 = t2, g1 = g2, t2 = lo + kInv * (hi - lo), g2 = gap(t2);
+    }
+  }
+  double t = 0.5 * (lo + hi);
+  for (double end : {0.0, 1.0})  // a minimum at an end is where the search ends nearest, not exactly on it
+    if (gap(end) <= gap(t)) t = end;
+  const Vec3 p = p0 + t * d, q = p.cwiseMax(-h).cwiseMin(h);
+  // Candidates, in the box frame: its face normals; the segment direction crossed with each (the edge
+  // axes of the Minkowski difference of segment and box); the direction between the closest points. The
+  // least overlap over directions is the penetration depth, or minus the distance, and one of these
+  // attains it: the closest-point direction when the core is outside the box, the face and edge axes of
+  // the (polyhedral) difference when the core cuts into it. Faces first, so that they win ties.
+  SmallVec<Vec3, 8> candidates;
+  for (int i = 0; i < 3; ++i) candidates.push_back(box.R.col(i));
+  const double scale = a.size() + b.size();
+  if ((p - q).norm() > 1e-9 * scale) candidates.push_back(box.R * (p - q).normalized());
+  for (int i = 0; i < 3; ++i) {
+    const Vec3 axis = d.cross(Vec3::Unit(i));
+    if (axis.norm() > 1e-6 * d.norm()) candidates.push_back(box.R * axis.normalized());
+  }
+  return least_overlap_axis(a, b, {candidates.begin(), candidates.end()}, 1e-12 * scale);
+}
+
 void rounded_contacts(const Placed& a, const Placed& b, const PairSettings& s, std::vector<ManifoldPoint>& out) {
   Vec3 a0, a1, b0, b1, pa, pb;
   core_segment(a, a0, a1);

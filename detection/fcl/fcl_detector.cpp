@@ -420,8 +420,10 @@ void FclDetector::Impl::narrow(Worker& w, const Placed& a, const Placed& b, cons
   if (is_rounded(ka) && is_rounded(kb)) return rounded_contacts(a, b, w.pair, w.points);
   if ((ka == ShapeKind::sphere && kb == ShapeKind::box) || (ka == ShapeKind::box && kb == ShapeKind::sphere))
     return sphere_box_contacts(a, b, w.pair, w.points);
-  if (ka == ShapeKind::box && kb == ShapeKind::box) {
-    const AxisResult axis = box_box_axis(a, b);
+  const bool capsule_box =
+      (ka == ShapeKind::capsule && kb == ShapeKind::box) || (ka == ShapeKind::box && kb == ShapeKind::capsule);
+  if ((ka == ShapeKind::box && kb == ShapeKind::box) || capsule_box) {
+    const AxisResult axis = capsule_box ? capsule_box_axis(a, b) : box_box_axis(a, b);
     if (axis.overlap >= -w.pair.margin) convex_contacts(a, b, axis, w.pair, w.points);
     return;
   }

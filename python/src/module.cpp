@@ -356,6 +356,16 @@ PYBIND11_MODULE(_impetus, m) {
       .def_property_readonly("time", [](PyWorld& w) { return w.world().time(); })
       .def_property_readonly("step_count", [](PyWorld& w) { return w.world().step_count(); })
       .def_property_readonly("dt", [](PyWorld& w) { return w.world().settings().dt; })
+      .def_property(
+          "threads", [](PyWorld& w) { return w.world().threads(); },
+          [](PyWorld& w, std::int64_t n) {
+            if (n < 0 || n > static_cast<std::int64_t>(World::kMaxThreads))
+              throw Error("World.threads: must be 0 (every core) to " + std::to_string(World::kMaxThreads) +
+                          ", got " + std::to_string(n));
+            w.world().set_threads(static_cast<std::uint32_t>(n));
+          },
+          "Threads a step may use (the scene's `threads`; 0: every core). Trajectories are bit-identical "
+          "for every value; set it between steps")
       .def_property_readonly("names", &PyWorld::names)
       .def_property_readonly("scene", &PyWorld::scene)
       .def("state", &PyWorld::state)

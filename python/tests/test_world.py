@@ -59,6 +59,23 @@ def test_state_round_trip_leaves_the_trajectory_bit_identical():
         assert np.array_equal(value, right.state()[key]), key
 
 
+def test_the_thread_count_changes_no_bit_of_the_trajectory():
+    scene = impetus.load_scene(SCENES / "demo.yaml")
+    one, two = impetus.World(scene), impetus.World(scene)
+    one.threads, two.threads = 1, 2
+    assert (one.threads, two.threads) == (1, 2)
+    one.step(100)
+    two.step(50)
+    two.threads = 4  # between steps
+    two.step(50)
+    for key, value in one.state().items():
+        assert np.array_equal(value, two.state()[key]), key
+    for bad in (-1, 4097):
+        with pytest.raises(impetus.Error, match="World.threads: must be 0"):
+            one.threads = bad
+    assert one.threads == 1
+
+
 def test_set_state_moves_bodies_and_checks_what_it_is_given():
     world = impetus.World(impetus.load_scene(CLI_SCENES / "drop.yaml"))
     s = world.state()

@@ -5,6 +5,7 @@
 #include "impetus/detection/fcl/analytic.hpp"
 
 #include <functional>
+#include <limits>
 #include <numbers>
 #include <random>
 
@@ -190,6 +191,48 @@ TEST(FclPairs, RandomPairsHaveFiniteOutwardNormalsAndConsistentDepths) {
     }
   }
   EXPECT_GT(checked, 500u);
+}
+
+TEST(FclPairs, CapsuleBoxAxisIsTheLeastOverlapOverEveryDirection) {
+  // capsule_box_axis (no FCL) on random poses from deep penetration to a clear gap. Two checks that do
+  // not use its candidates: (1) no direction overlaps less than the axis it returns (tried on 4000 random
+  // directions per pose), so it finds the true minimum over directions; (2) when the core segment stays
+  // out of the box, minus that minimum is the distance from the core to the box (sampled at 20001
+  // points, m) minus the radius.
+  std::mt19937 rng(2024);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  const auto random_rotation = [&] { return Mat3(Quat(u(rng), u(rng), u(rng), u(rng)).normalized()); };
+  const collision::ShapeGeometry capsule = collision::make_geometry(Capsule{0.2, 0.8}, nullptr);
+  const collision::ShapeGeometry box = collision::make_geometry(Box{Vec3(1.0, 0.6, 0.4)}, nullptr);
+  std::vector<Vec3> directions;
+  for (int i = 0; i < 4000; ++i) directions.push_back(Vec3(u(rng), u(rng), u(rng)).normalized());
+  int outside = 0;
+  for (int trial = 0; trial < 200; ++trial) {
+    const collision::Placed pc{&capsule, Vec3(u(rng), u(rng), u(rng)) * (0.2 + 0.6 * (trial % 4)), random_rotation()};
+    const collision::Placed pb{&box, Vec3::Zero(), random_rotation()};
+    for (bool capsule_first : {true, false}) {
+      const collision::Placed& a = capsule_first ? pc : pb;
+      const collision::Placed& b = capsule_first ? pb : pc;
+      const collision::AxisResult axis = collision::capsule_box_axis(a, b);
+      ASSERT_TRUE(axis.valid);
+      EXPECT_NEAR(axis.normal.norm(), 1.0, 1e-12);
+      EXPECT_NEAR(axis.overlap, collision::overlap_along(a, b, axis.normal), 1e-12);
+      for (const Vec3& n : directions) ASSERT_LE(axis.overlap, collision::overlap_along(a, b, n) + 1e-12) << trial;
+      if (!capsule_first) continue;
+      // The core in the box frame, sampled.
+      const Vec3 h = box.half_extents, half = capsule.half_length * pc.axis();
+      double nearest = std::numeric_limits<double>::infinity();
+      for (int i = 0; i <= 20000; ++i) {
+        const Vec3 p = pb.R.transpose() * (pc.x - half + (i / 10000.0) * half - pb.x);
+        nearest = std::min(nearest, (p - p.cwiseMax(-h).cwiseMin(h)).norm());
+      }
+      if (nearest < 1e-3) continue;  // the core cuts into the box: (1) is the check there
+      ++outside;
+      // Sampling at spacing Δ = 4e-5 m misses an interior minimum by at most Δ²/(2·distance) < 1e-6 m.
+      EXPECT_NEAR(-axis.overlap, nearest - capsule.radius, 1e-6) << trial;
+    }
+  }
+  EXPECT_GT(outside, 50);
 }
 
 /// A fixed convex plate 2 m × 2 m × 1 cm (8 vertices, 6 faces) with its top face at z = 0.

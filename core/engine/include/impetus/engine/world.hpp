@@ -171,7 +171,7 @@ class World {
   bool has_detector() const { return detector_ != nullptr; }
   bool has_resolver() const { return resolver_ != nullptr; }
 
- /// The most threads a world may be given.
+  /// The most threads a world may be given.
   static constexpr std::uint32_t kMaxThreads = 4096;
 
  private:

@@ -46,6 +46,12 @@ AxisResult least_overlap_axis(const Placed& a, const Placed& b, std::span<const 
 /// gives the largest separation along those axes.
 AxisResult box_box_axis(const Placed& a, const Placed& b);
 
+/// Capsule–box (either order), without FCL: the least overlap over the box's face normals, the capsule
+/// axis crossed with them and the direction between the closest points of the capsule's core segment and
+/// the box (found by a golden-section search, the squared distance being convex along the segment).
+/// Exact for penetration and for a gap.
+AxisResult capsule_box_axis(const Placed& a, const Placed& b);
+
 /// Spheres and capsules: exact, from the closest points of their cores (point or segment). Parallel
 /// capsules lying side by side get two points.
 void rounded_contacts(const Placed& a, const Placed& b, const PairSettings& s, std::vector<ManifoldPoint>& out);
