@@ -9,7 +9,8 @@
 //                 apart as 16 islands; a movable ground joins them into one island. Gravity off (the
 //                 heavy box would fall), the paper's drop velocities.
 //   primitives    the pyramid K = 10 of spheres (on) against the same pyramid of convex icosphere meshes
-//                 (642 vertices, radius 0.5; off): the detector's analytic sphere test against GJK/EPA.
+//                 (642 vertices, radius 0.5; off): the detector's analytic sphere test against FCL
+//                 (GJK, MPR and closest points).
 //                 A 5 mm margin in both rows, so the faceted spheres find the same 145 contacts.
 //   contact_reduction  a tower of 10 boxes, each turned 45° from the one below so that every face
 //                 contact is an octagon, under gravity: at most 4 points per pair (on) or all 8 (off).

@@ -1,6 +1,7 @@
 #include "impetus/detection/fcl/fcl_queries.hpp"
 
 #include "fcl_shape.hpp"
+#include "impetus/detection/fcl/analytic.hpp"
 
 #include <fcl/geometry/bvh/BVH_model.h>
 #include <fcl/geometry/shape/box.h>
@@ -13,7 +14,10 @@
 #include <fcl/narrowphase/distance.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
+#include <limits>
+#include <numbers>
 #include <stdexcept>
 
 namespace impetus::collision {
@@ -26,24 +30,85 @@ fcl::Transform3d transform_of(const Placed& s) {
   return t;
 }
 
-/// FCL's signed distance with witness points (see fcl_queries.hpp); `scale` sets the tolerance.
-SignedDistance signed_distance(const fcl::CollisionGeometryd& ga, const fcl::Transform3d& ta,
-                               const fcl::CollisionGeometryd& gb, const fcl::Transform3d& tb, double scale) {
-  // The default request gives no witness points and no penetration: ask for both. GJK for a gap, EPA
-  // (libccd, as fixed in FCL 0.6) for penetration; the tolerance follows the smaller shape.
-  fcl::DistanceRequestd request(true, true);
+/// GJK's distance between a and b, b moved by `shift` (m): the gap (> 0) with witness points (the one on
+/// b moved back), or not ok if they touch or FCL failed. Unsigned: no EPA (see signed_distance).
+SignedDistance gjk_gap(const fcl::CollisionGeometryd& ga, const fcl::Transform3d& ta,
+                       const fcl::CollisionGeometryd& gb, fcl::Transform3d tb, const Vec3& shift, double scale) {
+  tb.translation() += shift;
+  fcl::DistanceRequestd request(true);  // nearest points; enable_signed_distance stays off
   request.gjk_solver_type = fcl::GST_LIBCCD;
-  request.distance_tolerance = 1e-6 * scale;
+  request.distance_tolerance = 1e-9 * scale;
   fcl::DistanceResultd result;
+  fcl::distance(&ga, ta, &gb, tb, request, result);
+  if (!(result.min_distance > 0.0) || !std::isfinite(result.min_distance) || !result.nearest_points[0].allFinite() ||
+      !result.nearest_points[1].allFinite())
+    return {};
+  return {true, result.min_distance, result.nearest_points[0], result.nearest_points[1] - shift};
+}
+
+/// The signed distance (see fcl_queries.hpp) without FCL's signed-distance query, which runs EPA on
+/// penetration: Debian's FCL 0.7 is built with assertions, and EPA's `isOutsidePolytopeFace` aborts the
+/// process on flat, aligned contacts (FCL issue 322; a cylinder standing on a box is enough).
+///
+/// A gap: GJK's distance and witness points. Penetration: libccd's MPR (through FCL's collision query)
+/// gives a first direction n, not always the least-overlap one; then, by closest points, each step
+/// moves b out along n to a small gap δ past its overlap `overlap(n)` and takes the direction between
+/// GJK's witness points as the next n. The least-overlap direction n* is a fixed point (moved out along
+/// n*, the deepest points are the nearest), and near it the error shrinks by about (depth + δ) / (radius
+/// of curvature + δ) per step; on a flat face one step lands on its normal. The lowest overlap seen
+/// wins. `scale` (the smaller shape's size) sets δ and the tolerances.
+template <class Overlap>
+SignedDistance signed_distance(const fcl::CollisionGeometryd& ga, const fcl::Transform3d& ta,
+                               const fcl::CollisionGeometryd& gb, const fcl::Transform3d& tb, double scale,
+                               const Overlap& overlap) {
   try {
-    fcl::distance(&ga, ta, &gb, tb, request, result);
+    if (const SignedDistance gap = gjk_gap(ga, ta, gb, tb, Vec3::Zero(), scale); gap.ok) return gap;
+    fcl::CollisionRequestd contact_request(1, true);
+    contact_request.gjk_solver_type = fcl::GST_LIBCCD;
+    fcl::CollisionResultd contact_result;
+    fcl::collide(&ga, ta, &gb, tb, contact_request, contact_result);
+    // Starts: MPR's direction, the line of centers and, deep in (past 2 % of the smaller shape), the
+    // lowest of 128 directions spread evenly over the sphere (a Fibonacci lattice); deep in, the overlap
+    // over directions can have a lower minimum than the one MPR's direction leads to.
+    std::array<Vec3, 3> starts{tb.translation() - ta.translation(), tb.translation() - ta.translation(),
+                               Vec3::Zero()};
+    if (contact_result.numContacts() > 0) starts[0] = contact_result.getContact(0).normal;  // a to b
+    if (starts[0].allFinite() && starts[0].norm() > 0.0 && overlap(starts[0].normalized()) > 0.02 * scale) {
+      constexpr int kLattice = 128;
+      double lowest = std::numeric_limits<double>::infinity();
+      for (int k = 0; k < kLattice; ++k) {
+        const double z = 1.0 - (2.0 * k + 1.0) / kLattice, r = std::sqrt(1.0 - z * z);
+        const double phi = k * std::numbers::pi * (3.0 - std::sqrt(5.0));
+        const Vec3 n(r * std::cos(phi), r * std::sin(phi), z);
+        if (const double o = overlap(n); o < lowest) lowest = o, starts[2] = n;
+      }
+    }
+    constexpr int kSteps = 24;
+    const double delta = 0.01 * scale;
+    double least = std::numeric_limits<double>::infinity();
+    Vec3 least_n = Vec3::Zero();
+    for (Vec3 n : starts) {
+      if (!n.allFinite() || !(n.norm() > 0.0)) continue;
+      n.normalize();
+      for (int step = 0; step < kSteps; ++step) {
+        const double depth = overlap(n);
+        if (!std::isfinite(depth)) break;
+        if (depth < least) least = depth, least_n = n;
+        const Vec3 out = (depth + delta) * n;
+        const SignedDistance gap = gjk_gap(ga, ta, gb, tb, out, scale);
+        if (!gap.ok) break;
+        const Vec3 next = (gap.on_b + out - gap.on_a).normalized();
+        if (!next.allFinite() || (next - n).norm() < 1e-12) break;
+        n = next;
+      }
+    }
+    if (!std::isfinite(least)) return {};
+    // Witness points about the midpoint of the centers with on_a − on_b = depth · n (only n is used).
+    const Vec3 mid = 0.5 * (ta.translation() + tb.translation());
+    return {true, -least, mid + 0.5 * least * least_n, mid - 0.5 * least * least_n};
   } catch (const std::exception&) {
     return {};
   }
-  if (!std::isfinite(result.min_distance) || !result.nearest_points[0].allFinite() ||
-      !result.nearest_points[1].allFinite())
-    return {};
-  return {true, result.min_distance, result.nearest_points[0], result.nearest_points[1]};
 }
 
 std::shared_ptr<fcl::CollisionGeometryd> convex_geometry(const MeshData& mesh) {
@@ -87,7 +152,8 @@ FclShapePtr make_fcl_shape(const ShapeGeometry& g) {
 }
 
 SignedDistance fcl_signed_distance(const FclShape& ga, const Placed& a, const FclShape& gb, const Placed& b) {
-  return signed_distance(*ga.geometry, transform_of(a), *gb.geometry, transform_of(b), std::min(a.size(), b.size()));
+  return signed_distance(*ga.geometry, transform_of(a), *gb.geometry, transform_of(b), std::min(a.size(), b.size()),
+                         [&](const Vec3& n) { return overlap_along(a, b, n); });
 }
 
 bool fcl_triangles_near(const FclShape& mesh, const Placed& pose, const Aabb& box, std::size_t max_triangles,
@@ -117,8 +183,11 @@ SignedDistance fcl_signed_distance_triangle(const std::array<Vec3, 3>& tri, cons
   auto faces = std::make_shared<std::vector<int>>(std::vector<int>{3, 0, 1, 2, 3, 0, 2, 1});
   const fcl::Convexd triangle(vertices, 2, faces, false);
   const double size = std::max({(tri[1] - tri[0]).norm(), (tri[2] - tri[1]).norm(), (tri[0] - tri[2]).norm()});
+  const auto overlap = [&](const Vec3& n) {
+    return std::max({n.dot(tri[0]), n.dot(tri[1]), n.dot(tri[2])}) + support_height(pose, -n);
+  };
   return signed_distance(triangle, fcl::Transform3d::Identity(), *shape.geometry, transform_of(pose),
-                         std::min(size, pose.size()));
+                         std::min(size, pose.size()), overlap);
 }
 
 }  // namespace impetus::collision

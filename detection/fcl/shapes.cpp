@@ -144,12 +144,13 @@ Vec3 support(const Placed& s, const Vec3& d) {
       return s.x + (u.dot(d) >= 0 ? g.half_length : -g.half_length) * u + g.radius * d;
     }
     case ShapeKind::cylinder: {
-      const Vec3 u = s.axis();
-      const double a = u.dot(d);
-      const Vec3 w = d - a * u;
-      const double wn = w.norm();
-      const Vec3 cap = s.x + (a >= 0 ? g.half_length : -g.half_length) * u;
-      return wn > 1e-12 ? Vec3(cap + (g.radius / wn) * w) : cap;
+      // In the body frame, where the radial part of d is exactly perpendicular to the axis: in the world
+      // frame, d − (u·d)u keeps a rounding error along u (u is unit only to 1e-16), and divided by a
+      // tiny radial length it moved the height by up to 1e-5 m for d within 1e-8 rad of the axis.
+      const Vec3 dl = s.R.transpose() * d;
+      const double wn = std::hypot(dl.x(), dl.y());
+      const Vec3 rim = wn > 0.0 ? Vec3(g.radius * dl.x() / wn, g.radius * dl.y() / wn, 0.0) : Vec3::Zero();
+      return s.x + s.R * (rim + Vec3(0.0, 0.0, dl.z() >= 0 ? g.half_length : -g.half_length));
     }
     case ShapeKind::convex:
     case ShapeKind::triangles: {

@@ -2,7 +2,7 @@
 /// \file
 /// FCL-free narrowphase pieces: exact contacts for the pairs that have a closed form (sphere and capsule
 /// pairs, sphere–box, anything against a plane), the box–box separating-axis test, and the separating
-/// axis refinement that turns an approximate normal (from FCL's GJK/EPA) into the exact face normal
+/// axis refinement that turns an approximate normal (from FCL's GJK and MPR) into the exact face normal
 /// when the contact is face-based, and checks its orientation.
 ///
 /// Every function appends contacts with the normal out of `a` into `b` (docs/conventions.md) and a depth

@@ -1,7 +1,7 @@
 #pragma once
 /// \file
 /// The default collision detector, `fcl`: FCL 0.7's dynamic AABB trees for the broadphase, exact
-/// closed forms where they exist and FCL's GJK/EPA (convex shapes) or BVH queries (triangle meshes) for
+/// closed forms where they exist and FCL's GJK and MPR (convex shapes) or BVH queries (triangle meshes) for
 /// the rest, and real contact manifolds (up to 4 points per pair spanning the contact area). See
 /// README.md for what it assumes, guarantees and where it fails. No FCL header here (pimpl).
 ///

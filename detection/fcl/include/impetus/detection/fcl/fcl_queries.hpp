@@ -1,8 +1,8 @@
 #pragma once
 /// \file
 /// The FCL queries behind an FCL-free interface: building FCL geometry from the engine's shapes, the
-/// signed-distance query (GJK, then EPA for penetration) used for generic convex pairs and against mesh
-/// triangles, and the BVH midphase of triangle meshes. No FCL header here (see fcl_shape.hpp).
+/// signed-distance query (GJK for a gap; MPR, then closest points, for penetration; never EPA) used for
+/// generic convex pairs and against mesh triangles, and the BVH midphase of triangle meshes. No FCL header here (see fcl_shape.hpp).
 
 #include "impetus/detection/fcl/manifold.hpp"
 #include "impetus/detection/fcl/shapes.hpp"
@@ -24,9 +24,11 @@ using FclShapePtr = std::shared_ptr<const FclShape>;
 FclShapePtr make_fcl_shape(const ShapeGeometry& g);
 
 /// Signed distance between two convex shapes: > 0 the gap, < 0 minus the penetration depth (m), with
-/// the witness points: nearest points for a gap; for penetration the point of a deepest inside b and
-/// the point of b deepest inside a (so on_a − on_b = depth · n). `ok` is false if FCL failed (it throws
-/// on a few degenerate configurations; the caller falls back to candidate axes).
+/// witness points: the nearest points for a gap (GJK); for penetration two points with on_a − on_b =
+/// depth · n along the least-overlap direction n found by closest points (see fcl_queries.cpp; exact
+/// only to ~1e-6 m, and deep in possibly a local minimum: a hint for the separating-axis refinement).
+/// `ok` is false if FCL failed (it throws on a few degenerate configurations; the caller falls back to
+/// candidate axes). Never FCL's EPA, whose assertions abort the process (FCL issue 322).
 struct SignedDistance {
   bool ok = false;
   double distance = 0.0;
