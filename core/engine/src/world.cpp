@@ -4,11 +4,13 @@
 #include "impetus/core/format.hpp"
 #include "impetus/engine/metrics.hpp"
 
+#include <tbb/parallel_for.h>
 #include <tbb/task_arena.h>
 
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdint>
 #include <string>
 #include <string_view>
 #include <unordered_set>
@@ -52,6 +54,34 @@ const char* measure_overflow(const RigidBody& b, const Vec3& gravity, MeasureSum
   if (!std::isfinite(potential) || !std::isfinite(sums.potential)) return "potential energy";
   return nullptr;
 }
+
+// The world's own passes over the bodies (the state checks, the energies around the resolver, the
+// snapshot) run on fixed chunks of bodies in parallel. The chunks do not depend on the thread count and
+// their sums are combined in chunk order, so every result is the same for 1 or 64 threads.
+constexpr std::size_t kChunk = 1024;
+
+std::size_t chunk_count(std::size_t n) { return (n + kChunk - 1) / kChunk; }
+
+/// fn(chunk, begin, end) for every chunk of [0, n), in parallel when there is more than one.
+template <class Fn>
+void for_each_chunk(std::size_t n, const Fn& fn) {
+  const std::size_t chunks = chunk_count(n);
+  if (chunks == 1) return fn(std::size_t{0}, std::size_t{0}, n);
+  tbb::parallel_for(std::size_t{0}, chunks, [&](std::size_t c) { fn(c, c * kChunk, std::min(n, (c + 1) * kChunk)); });
+}
+
+// One chunk's part of check_finite: its non-finite bodies, else the first body whose measure (or the
+// chunk's running sum) overflows, and the chunk's sums.
+struct ChunkCheck {
+  std::size_t non_finite = 0, first_bad = SIZE_MAX, first_overflow = SIZE_MAX;
+  const char* overflow = nullptr;
+  MeasureSums sums;
+};
+
+// One chunk's kinetic energy and load potential (as total_kinetic_energy and load_potential_energy).
+struct ChunkEnergy {
+  double kinetic = 0.0, potential = 0.0;
+};
 
 std::string body_label(const RigidBody& body, std::size_t index) {
   return "body '" + (body.name.empty() ? "#" + std::to_string(index) : body.name) + "'";
@@ -164,6 +194,20 @@ World::~World() = default;
 struct World::Threads {
   explicit Threads(std::uint32_t n) : arena(n == 0 ? tbb::task_arena::automatic : static_cast<int>(n)) {}
   tbb::task_arena arena;
+  std::vector<ChunkCheck> checks;    // per chunk, reused every step
+  std::vector<ChunkEnergy> energies;
+
+  /// Kinetic energy and load potential of the movable bodies, chunk by chunk (see for_each_chunk).
+  ChunkEnergy energy(std::span<const RigidBody> bodies, const Vec3& g) {
+    energies.assign(chunk_count(bodies.size()), ChunkEnergy{});
+    for_each_chunk(bodies.size(), [&](std::size_t c, std::size_t begin, std::size_t end) {
+      energies[c] = {total_kinetic_energy(bodies.subspan(begin, end - begin)),
+                     load_potential_energy(bodies.subspan(begin, end - begin), g)};
+    });
+    ChunkEnergy total;
+    for (const ChunkEnergy& e : energies) total.kinetic += e.kinetic, total.potential += e.potential;
+    return total;
+  }
 };
 
 void World::set_threads(std::uint32_t threads) {
@@ -381,11 +425,12 @@ void World::resolve(StepStatus& status) {
   if (resolver_ && (!contacts_.empty() || !constraints_.empty())) {
     // Measured around the resolver so that a run can tell energy lost in impacts from energy the
     // integrator gains or loses (the run summary's energy balance).
-    const double kinetic = total_kinetic_energy(bodies_), potential = load_potential_energy(bodies_, settings_.gravity);
+    const ChunkEnergy before = threads_->energy(bodies_, settings_.gravity);
     resolver_->resolve(bodies_, contacts_, constraints_, context(), status.resolver);
-    status.resolve_kinetic_energy_change = total_kinetic_energy(bodies_) - kinetic;
+    const ChunkEnergy after = threads_->energy(bodies_, settings_.gravity);
+    status.resolve_kinetic_energy_change = after.kinetic - before.kinetic;
     status.prescribed_work = prescribed_contact_work(bodies_, contacts_);
-    status.resolve_potential_energy_change = load_potential_energy(bodies_, settings_.gravity) - potential;
+    status.resolve_potential_energy_change = after.potential - before.potential;
   }
   status.profile.resolve = seconds_since(start);
 }
@@ -393,14 +438,24 @@ void World::resolve(StepStatus& status) {
 // A non-finite state never propagates: every body is rolled back to its state before the step and the
 // status names the first offender and the stage that produced it.
 bool World::check_finite(StepStatus& status, const char* stage) {
-  std::size_t first_bad = bodies_.size();
-  for (std::size_t i = 0; i < bodies_.size(); ++i) {
-    if (!state_is_finite(bodies_[i])) {
-      ++status.nan_caught;
-      if (first_bad == bodies_.size()) first_bad = i;
+  std::vector<ChunkCheck>& checks = threads_->checks;
+  checks.assign(chunk_count(bodies_.size()), ChunkCheck{});
+  for_each_chunk(bodies_.size(), [&](std::size_t c, std::size_t begin, std::size_t end) {
+    ChunkCheck& check = checks[c];
+    for (std::size_t i = begin; i < end; ++i) {
+      if (!state_is_finite(bodies_[i])) {
+        if (check.non_finite++ == 0) check.first_bad = i;
+      } else if (check.non_finite == 0 && !check.overflow) {
+        if ((check.overflow = measure_overflow(bodies_[i], settings_.gravity, check.sums))) check.first_overflow = i;
+      }
     }
+  });
+  std::size_t first_bad = SIZE_MAX;
+  for (const ChunkCheck& check : checks) {
+    status.nan_caught += check.non_finite;
+    first_bad = std::min(first_bad, check.first_bad);
   }
-  if (first_bad < bodies_.size()) {
+  if (first_bad != SIZE_MAX) {
     status.ok = false;
     status.message = body_label(bodies_[first_bad], first_bad) + " became non-finite during " + stage +
                      " at step " + std::to_string(step_count_) + "; state restored to before the step";
@@ -408,18 +463,33 @@ bool World::check_finite(StepStatus& status, const char* stage) {
     return false;
   }
   // A finite but absurd state (1e200 m/s, dt = 1e300 s) whose energy or momentum overflows is stopped
-  // the same way: the run's summary would otherwise report inf or nan.
-  MeasureSums sums;
-  for (std::size_t i = 0; i < bodies_.size(); ++i) {
-    if (const char* what = measure_overflow(bodies_[i], settings_.gravity, sums)) {
-      ++status.nan_caught;
-      status.ok = false;
-      status.message = body_label(bodies_[i], i) + ": its " + what + " (or the world's total) overflowed during " +
-                       stage + " at step " + std::to_string(step_count_) +
-                       " (a finite state too large to measure); state restored to before the step";
-      restore_snapshot();
-      return false;
+  // the same way: the run's summary would otherwise report inf or nan. A body's own measure or its
+  // chunk's sum first, then the world's total, summed chunk by chunk.
+  MeasureSums total;
+  for (std::size_t c = 0; c < checks.size(); ++c) {
+    const ChunkCheck& check = checks[c];
+    std::size_t at = check.first_overflow;
+    const char* what = check.overflow;
+    if (!what) {
+      total.kinetic += check.sums.kinetic;
+      total.potential += check.sums.potential;
+      total.linear += check.sums.linear;
+      total.angular += check.sums.angular;
+      at = std::min(bodies_.size(), (c + 1) * kChunk) - 1;  // the chunk's last body
+      what = !std::isfinite(total.kinetic) ? "kinetic energy"
+             : !all_finite(total.linear)   ? "linear momentum"
+             : !all_finite(total.angular)  ? "angular momentum"
+             : !std::isfinite(total.potential) ? "potential energy"
+                                               : nullptr;
     }
+    if (!what) continue;
+    ++status.nan_caught;
+    status.ok = false;
+    status.message = body_label(bodies_[at], at) + ": its " + what + " (or the world's total) overflowed during " +
+                     stage + " at step " + std::to_string(step_count_) +
+                     " (a finite state too large to measure); state restored to before the step";
+    restore_snapshot();
+    return false;
   }
   return true;
 }
@@ -427,10 +497,12 @@ bool World::check_finite(StepStatus& status, const char* stage) {
 // Only the state is saved (not names or shapes): this runs every step.
 void World::take_snapshot() {
   snapshot_.resize(bodies_.size());
-  for (std::size_t i = 0; i < bodies_.size(); ++i) {
-    const RigidBody& b = bodies_[i];
-    snapshot_[i] = {b.position, b.rotation, b.velocity, b.angular_velocity};
-  }
+  for_each_chunk(bodies_.size(), [&](std::size_t, std::size_t begin, std::size_t end) {
+    for (std::size_t i = begin; i < end; ++i) {
+      const RigidBody& b = bodies_[i];
+      snapshot_[i] = {b.position, b.rotation, b.velocity, b.angular_velocity};
+    }
+  });
 }
 
 void World::restore_snapshot() {
