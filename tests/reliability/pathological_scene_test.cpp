@@ -198,6 +198,32 @@ TEST(PathologicalScenes, OverflowingKineticEnergyFailsTheStepNamingTheBody) {
   EXPECT_NE(added.find("kinetic energy"), std::string::npos) << added;
 }
 
+TEST(PathologicalScenes, AWorldTotalThatOverflowsFailsTheStepForEveryThreadCount) {
+  // 3000 balls of 1e305 J each: every ball, and every chunk of 1024 that the world sums in parallel
+  // (1.024e308 J), is finite; the world's total (3e308 J) is not. The step fails naming a body and the
+  // total, leaves the state as it was, and does so alike on 1 and 2 threads.
+  std::ostringstream text;
+  text << "modules: {detector: none, resolver: none}\nbodies:\n";
+  const double speed = std::sqrt(2.0e305);  // ½ · 1 kg · v² = 1e305 J
+  for (int i = 0; i < 3000; ++i)
+    text << "  - {name: b" << i << ", shape: {sphere: {radius: 0.5}}, mass: 1, position: [" << 2 * i
+         << ", 0, 0], velocity: [0, 0, " << (i % 2 ? speed : -speed) << "]}\n";
+  const auto host = make_host();
+  std::vector<std::string> messages;
+  for (const std::uint32_t threads : {1u, 2u}) {
+    const auto world = world_of(text.str(), *host);
+    world->set_threads(threads);
+    const std::vector<std::uint64_t> before = state_bits(*world);
+    const StepStatus& status = world->step();
+    EXPECT_FALSE(status.ok);
+    EXPECT_NE(status.message.find("kinetic energy (or the world's total) overflowed"), std::string::npos)
+        << status.message;
+    EXPECT_EQ(state_bits(*world), before);
+    messages.push_back(status.message);
+  }
+  EXPECT_EQ(messages[0], messages[1]);
+}
+
 TEST(PathologicalScenes, AnAbsurdTimeStepFailsTheStepNamingTheBody) {
   const auto host = make_host();
   const auto world = world_of(
