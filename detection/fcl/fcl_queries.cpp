@@ -56,11 +56,11 @@ SignedDistance gjk_gap(const fcl::CollisionGeometryd& ga, const fcl::Transform3d
 /// GJK's witness points as the next n. The least-overlap direction n* is a fixed point (moved out along
 /// n*, the deepest points are the nearest), and near it the error shrinks by about (depth + δ) / (radius
 /// of curvature + δ) per step; on a flat face one step lands on its normal. The lowest overlap seen
-/// wins. `scale` (the smaller shape's size) sets δ and the tolerances.
+/// wins. `scale` (the smaller shape's size) sets δ and the tolerances; `center_a` is a's center (world).
 template <class Overlap>
 SignedDistance signed_distance(const fcl::CollisionGeometryd& ga, const fcl::Transform3d& ta,
                                const fcl::CollisionGeometryd& gb, const fcl::Transform3d& tb, double scale,
-                               const Overlap& overlap) {
+                               const Vec3& center_a, const Overlap& overlap) {
   try {
     if (const SignedDistance gap = gjk_gap(ga, ta, gb, tb, Vec3::Zero(), scale); gap.ok) return gap;
     fcl::CollisionRequestd contact_request(1, true);
@@ -70,8 +70,7 @@ SignedDistance signed_distance(const fcl::CollisionGeometryd& ga, const fcl::Tra
     // Starts: MPR's direction, the line of centers and, deep in (past 2 % of the smaller shape), the
     // lowest of 128 directions spread evenly over the sphere (a Fibonacci lattice); deep in, the overlap
     // over directions can have a lower minimum than the one MPR's direction leads to.
-    std::array<Vec3, 3> starts{tb.translation() - ta.translation(), tb.translation() - ta.translation(),
-                               Vec3::Zero()};
+    std::array<Vec3, 3> starts{tb.translation() - center_a, tb.translation() - center_a, Vec3::Zero()};
     if (contact_result.numContacts() > 0) starts[0] = contact_result.getContact(0).normal;  // a to b
     if (starts[0].allFinite() && starts[0].norm() > 0.0 && overlap(starts[0].normalized()) > 0.02 * scale) {
       constexpr int kLattice = 128;
@@ -104,7 +103,7 @@ SignedDistance signed_distance(const fcl::CollisionGeometryd& ga, const fcl::Tra
     }
     if (!std::isfinite(least)) return {};
     // Witness points about the midpoint of the centers with on_a − on_b = depth · n (only n is used).
-    const Vec3 mid = 0.5 * (ta.translation() + tb.translation());
+    const Vec3 mid = 0.5 * (center_a + tb.translation());
     return {true, -least, mid + 0.5 * least * least_n, mid - 0.5 * least * least_n};
   } catch (const std::exception&) {
     return {};
@@ -153,7 +152,7 @@ FclShapePtr make_fcl_shape(const ShapeGeometry& g) {
 
 SignedDistance fcl_signed_distance(const FclShape& ga, const Placed& a, const FclShape& gb, const Placed& b) {
   return signed_distance(*ga.geometry, transform_of(a), *gb.geometry, transform_of(b), std::min(a.size(), b.size()),
-                         [&](const Vec3& n) { return overlap_along(a, b, n); });
+                         a.x, [&](const Vec3& n) { return overlap_along(a, b, n); });
 }
 
 bool fcl_triangles_near(const FclShape& mesh, const Placed& pose, const Aabb& box, std::size_t max_triangles,
@@ -187,7 +186,7 @@ SignedDistance fcl_signed_distance_triangle(const std::array<Vec3, 3>& tri, cons
     return std::max({n.dot(tri[0]), n.dot(tri[1]), n.dot(tri[2])}) + support_height(pose, -n);
   };
   return signed_distance(triangle, fcl::Transform3d::Identity(), *shape.geometry, transform_of(pose),
-                         std::min(size, pose.size()), overlap);
+                         std::min(size, pose.size()), (tri[0] + tri[1] + tri[2]) / 3.0, overlap);
 }
 
 }  // namespace impetus::collision
