@@ -3,8 +3,13 @@
 //
 // Bodies: each movable body in its principal frame (Bullet takes a diagonal local inertia), so the
 // Bullet transform is R·V with J_body = V diag(d) Vᵀ, and the shape sits in that frame through a compound
-// when V is not the identity. Frictionless (the suite's scenes are), restitution √e on every body (Bullet
-// multiplies the two bodies' coefficients: the product is the scene's e), no damping, no deactivation.
+// when V is not the identity. Restitution √e on every body (Bullet multiplies the two bodies'
+// coefficients: the product is the scene's e), no damping, no deactivation.
+// Friction: each body's friction is √μ, so that the product Bullet forms for a contact is Impetus's
+// geometric mean √(μ_a μ_b); no rolling or spinning friction (Impetus's point contacts have none).
+// Bullet's friction as shipped: per contact point one friction row along the tangential slip, or along an
+// arbitrary tangent where there is none (the second direction, SOLVER_USE_2_FRICTION_DIRECTIONS, is off
+// by default), clamped to ±μ times the point's current normal impulse inside the iterations.
 // Joints: btPoint2PointConstraint with the joined bodies' collisions disabled, as Impetus does.
 // Settings: impact scenarios use the impulse-problem settings of bench_peers (contact ERP 0, split
 // impulse off); simulations keep btContactSolverInfo as shipped (ERP 0.2, split impulse on) except the
@@ -137,7 +142,7 @@ class BulletWorld final : public PeerWorld {
     }
     btRigidBody::btRigidBodyConstructionInfo info(b.fixed ? 0.0 : b.mass, nullptr, shape.get(), inertia);
     info.m_startWorldTransform = pose;
-    info.m_friction = 0.0;
+    info.m_friction = std::sqrt(b.material.friction);
     info.m_rollingFriction = 0.0;
     info.m_spinningFriction = 0.0;
     info.m_restitution = restitution;
@@ -193,7 +198,7 @@ void add_bullet_methods(std::vector<PeerMethod>& out) {
     m.integrator = "Bullet (semi-implicit Euler)";
     m.description = "btSequentialImpulseConstraintSolver, " + std::to_string(iterations) +
                     " iterations" + (iterations == 10 ? " (Bullet's default)" : "") +
-                    "; impacts: contact ERP 0, split impulse off; simulations: ERP 0.2 and split impulse as shipped";
+                    "; friction as shipped (one row per point, along the slip); impacts: contact ERP 0, split impulse off; simulations: ERP 0.2 and split impulse as shipped";
     m.unsupported = bullet_unsupported;
     m.make = [iterations](const PeerScene& scene) { return std::make_unique<BulletWorld>(scene, iterations); };
     out.push_back(std::move(m));

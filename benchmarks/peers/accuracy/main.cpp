@@ -43,6 +43,8 @@ class ImpulseStamp final : public CollisionResolver {
   std::vector<PeerContact> points;
 
   ModuleStatus accept_constraints(std::span<const Constraint>) noexcept override { return ModuleStatus::success(); }
+  /// The engine applied the friction; this resolver only records its normal impulses.
+  ModuleStatus accept_friction() noexcept override { return ModuleStatus::success(); }
 
   void resolve(std::span<RigidBody>, std::span<Contact> contacts, std::span<const Constraint>, const StepContext&,
                ResolverCounters&) noexcept override {
@@ -107,12 +109,10 @@ RunResult run(const Scenario& scenario, const PeerMethod& method, double dt, con
     result.message = e.what();
     return result;
   }
-  // The peers' friction (ODE's pyramid, Bullet's and MuJoCo's cones) is not translated yet: a scene with
-  // friction is refused for every engine rather than run without it.
-  // Nor are applied loads and prescribed motions.
+  // Applied loads and prescribed motions are not translated to the peers yet: such a scene is refused for
+  // every engine rather than run without them. (Friction is: each engine's translation says how.)
   for (const RigidBody& b : world->bodies()) {
-    const char* missing = b.material.friction > 0.0              ? "friction"
-                          : b.loaded()                           ? "an applied load"
+    const char* missing = b.loaded()                           ? "an applied load"
                           : b.motion != PrescribedMotion::none ? "a prescribed motion"
                                                                  : nullptr;
     if (missing) {

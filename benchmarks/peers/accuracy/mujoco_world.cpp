@@ -1,9 +1,14 @@
 // MuJoCo on the accuracy scenarios: an MJCF model written from the Impetus bodies (one free body per
 // movable body, its frame the Impetus body frame, with the Impetus mass and full inertia; fixed bodies as
-// world geoms), every geom condim 1 (frictionless), contacts as shipped (solref 0.02 1, solimp 0.9 0.95
-// 0.001: soft by design), point-point constraints as `connect` equality constraints (soft too), Euler
+// world geoms), contacts as shipped (solref 0.02 1, solimp 0.9 0.95 0.001: soft by design), point-point
+// constraints as `connect` equality constraints (soft too), Euler
 // integrator, solver Newton or PGS with 100 iterations and tolerance 1e-10. Impetus's collision filter
 // (groups and masks both ways, joined bodies) is reproduced with <exclude> pairs.
+// Friction: a frictionless scene has condim 1 on every geom. With friction, condim 3 (sliding friction
+// only: Impetus's point contacts have no torsional or rolling friction), geom friction "μ 0 0" and elliptic
+// cones (Coulomb's circular cone, as Impetus; MuJoCo ships pyramidal ones). MuJoCo gives a contact the
+// larger of its two geoms' μ, which equals Impetus's √(μ_a μ_b) only when they are equal: a scene whose
+// touching bodies have different μ is refused.
 #include "peer_world.hpp"
 
 #include "../mujoco_support.hpp"
@@ -51,8 +56,17 @@ std::string geom(const RigidBody& b) {
   return x.str();
 }
 
+/// The one μ of every body that may touch another (mujoco_unsupported refuses a scene with several).
+double scene_friction(const PeerScene& scene) {
+  for (std::size_t i = 0; i < scene.bodies.size(); ++i)
+    for (std::size_t j = i + 1; j < scene.bodies.size(); ++j)
+      if (may_collide(scene, i, j) && pair_friction(scene.bodies, i, j) > 0) return scene.bodies[i].material.friction;
+  return 0.0;
+}
+
 std::string make_mjcf(const PeerScene& scene, int solver) {
   const bool no_contacts = contact_free(scene);
+  const double mu = no_contacts ? 0.0 : scene_friction(scene);
   std::size_t movable = 0;
   for (const RigidBody& b : scene.bodies) movable += b.fixed ? 0 : 1;
   // MuJoCo 2.2 allocates dense njmax-sized arrays: room for 8 contact rows per body and 3 per joint.
@@ -63,9 +77,9 @@ std::string make_mjcf(const PeerScene& scene, int solver) {
     << "  <size nconmax=\"" << capacity << "\" njmax=\"" << capacity << "\"/>\n"
     << "  <option timestep=\"" << scene.settings.dt << "\" gravity=\"" << vec(scene.settings.gravity)
     << "\" integrator=\"Euler\" solver=\"" << (solver == mjSOL_PGS ? "PGS" : "Newton")
-    << "\" iterations=\"100\" tolerance=\"1e-10\"/>\n"
-    << "  <default><geom condim=\"1\" contype=\"" << (no_contacts ? 0 : 1) << "\" conaffinity=\""
-    << (no_contacts ? 0 : 1) << "\"/></default>\n  <worldbody>\n";
+    << "\" iterations=\"100\" tolerance=\"1e-10\"" << (mu > 0 ? " cone=\"elliptic\"" : "") << "/>\n"
+    << "  <default><geom condim=\"" << (mu > 0 ? 3 : 1) << "\" friction=\"" << mu << " 0 0\" contype=\""
+    << (no_contacts ? 0 : 1) << "\" conaffinity=\"" << (no_contacts ? 0 : 1) << "\"/></default>\n  <worldbody>\n";
   for (std::size_t i = 0; i < scene.bodies.size(); ++i) {
     const RigidBody& b = scene.bodies[i];
     if (!b.fixed) continue;
@@ -160,11 +174,13 @@ class MujocoWorld final : public PeerWorld {
     std::vector<PeerContact> out;
     for (int c = 0; c < data_->ncon; ++c) {
       const mjContact& contact = data_->contact[c];
-      // condim 1: one constraint row, the normal force (N); its impulse over the step is force·dt.
+      // The normal force (N) in the contact frame (condim 1: the one row; condim 3, elliptic: the first
+      // of three); its impulse over the step is force·dt.
+      mjtNum force[6] = {0, 0, 0, 0, 0, 0};
+      if (contact.efc_address >= 0) mj_contactForce(model_, data_, c, force);
       out.push_back({geom_body_[static_cast<std::size_t>(contact.geom1)],
                      geom_body_[static_cast<std::size_t>(contact.geom2)],
-                     Vec3(contact.pos[0], contact.pos[1], contact.pos[2]),
-                     contact.efc_address >= 0 ? data_->efc_force[contact.efc_address] * dt_ : 0.0});
+                     Vec3(contact.pos[0], contact.pos[1], contact.pos[2]), force[0] * dt_});
     }
     return out;
   }
@@ -193,6 +209,11 @@ std::string mujoco_unsupported(const PeerScene& scene) {
   if (!first_mesh(scene).empty())
     return "mesh body '" + first_mesh(scene) + "': MuJoCo collides a mesh as its convex hull, not as the triangle "
            "mesh the scene asks for";
+  for (std::size_t i = 0; i < scene.bodies.size(); ++i)
+    for (std::size_t j = i + 1; j < scene.bodies.size(); ++j)
+      if (may_collide(scene, i, j) && scene.bodies[i].material.friction != scene.bodies[j].material.friction)
+        return "bodies '" + scene.bodies[i].name + "' and '" + scene.bodies[j].name +
+               "' have different friction: MuJoCo gives a contact the larger μ, Impetus √(μ_a μ_b)";
   if (scene_restitution(scene.bodies) > 0)
     return "restitution: MuJoCo has no coefficient of restitution (a bounce only comes from an under-damped "
            "solref, not a given e)";
@@ -211,7 +232,7 @@ void add_mujoco_methods(std::vector<PeerMethod>& out) {
     m.integrator = "MuJoCo Euler (semi-implicit)";
     m.description = std::string("solver ") + (solver == mjSOL_PGS ? "PGS" : "Newton") +
                     ", 100 iterations, tolerance 1e-10; contacts and connect constraints as shipped (soft: "
-                    "solref 0.02 1, solimp 0.9 0.95 0.001); condim 1";
+                    "solref 0.02 1, solimp 0.9 0.95 0.001); condim 1, with friction condim 3 and elliptic cones";
     m.unsupported = mujoco_unsupported;
     const int s = solver;
     m.make = [s](const PeerScene& scene) { return std::make_unique<MujocoWorld>(scene, s); };

@@ -3,7 +3,11 @@
 // joints from dCollide (up to 8 points per pair) in the usual near callback, ball joints for point-point
 // constraints; one dWorldStep (Dantzig LCP) or dWorldQuickStep (projected SOR) per step.
 //
-// Contacts: mu = 0, bounce = the scene's e (bounce_vel 0), surface layer 0, world CFM 1e-10 (ODE's
+// Friction: each contact's mu is Impetus's √(μ_a μ_b) with dContactApprox1, so that ODE bounds each of its
+// two friction directions (a pyramid of 4 faces, the first direction ODE's own choice) by mu times the
+// contact's normal force, a Coulomb law on a pyramid. Without dContactApprox1, ODE's mu is a fixed force
+// bound in newtons, not a coefficient: not a translation of μ. A frictionless pair gets mu = 0.
+// Contacts: bounce = the scene's e (bounce_vel 0), surface layer 0, world CFM 1e-10 (ODE's
 // double-precision default). ERP: impact scenarios 0 for QuickStep and 1e-6 for dWorldStep (the "perturbed"
 // setting of bench_peers: with ERP 0 the Dantzig LCP stops with "s <= 0" on a contact touching with zero
 // normal velocity and applies nothing); simulations 0.2 as shipped.
@@ -125,8 +129,9 @@ class OdeWorld final : public PeerWorld {
     const int n = dCollide(g1, g2, 8, &contacts[0].geom, sizeof(dContact));
     for (int k = 0; k < n; ++k) {
       dContact& c = contacts[k];
-      c.surface.mode = self.restitution_ > 0 ? dContactBounce : 0;
-      c.surface.mu = 0.0;
+      const double mu = pair_friction(self.scene_.bodies, index_of(g1), index_of(g2));
+      c.surface.mode = (self.restitution_ > 0 ? dContactBounce : 0) | (mu > 0 ? dContactApprox1 : 0);
+      c.surface.mu = mu;
       c.surface.bounce = self.restitution_;
       c.surface.bounce_vel = 0.0;
       const dJointID joint = dJointCreateContact(self.world_, self.contact_group_, &c);
@@ -210,14 +215,16 @@ void add_ode_methods(std::vector<PeerMethod>& out) {
   quick.setting = "quickstep_20";
   quick.integrator = "ODE (semi-implicit Euler)";
   quick.description = "dWorldQuickStep, 20 iterations (ODE's default), CFM 1e-10; ERP 0 on impacts, 0.2 (shipped) "
-                      "in simulations";
+                      "in simulations; friction: mu = √(μ_a μ_b) with dContactApprox1 (a pyramid scaled by the "
+                      "normal force)";
   quick.unsupported = ode_unsupported;
   quick.make = [](const PeerScene& scene) { return std::make_unique<OdeWorld>(scene, OdeConfig{true, 20}); };
   out.push_back(quick);
   PeerMethod exact = quick;
   exact.setting = "worldstep";
   exact.description = "dWorldStep (Dantzig LCP), CFM 1e-10; ERP 1e-6 on impacts (the light regularization without "
-                      "which the LCP gives up silently on zero-velocity contacts), 0.2 (shipped) in simulations";
+                      "which the LCP gives up silently on zero-velocity contacts), 0.2 (shipped) in simulations; friction: mu = "
+                      "√(μ_a μ_b) with dContactApprox1 (a pyramid scaled by the normal force)";
   exact.make = [](const PeerScene& scene) { return std::make_unique<OdeWorld>(scene, OdeConfig{false, 20}); };
   out.push_back(exact);
 }

@@ -4,6 +4,7 @@
 #include <Eigen/Eigenvalues>
 
 #include <algorithm>
+#include <cmath>
 #include <variant>
 
 namespace impetus::peers::accuracy {
@@ -41,6 +42,17 @@ bool may_collide(const PeerScene& scene, std::size_t i, std::size_t j) {
     if (joined) return false;
   }
   return true;
+}
+
+double pair_friction(std::span<const RigidBody> bodies, std::size_t i, std::size_t j) {
+  return std::sqrt(bodies[i].material.friction * bodies[j].material.friction);
+}
+
+bool has_friction(const PeerScene& scene) {
+  for (std::size_t i = 0; i < scene.bodies.size(); ++i)
+    for (std::size_t j = i + 1; j < scene.bodies.size(); ++j)
+      if (pair_friction(scene.bodies, i, j) > 0.0 && may_collide(scene, i, j)) return true;
+  return false;
 }
 
 std::string first_mesh(const PeerScene& scene) {

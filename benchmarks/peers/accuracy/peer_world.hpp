@@ -90,6 +90,11 @@ double scene_restitution(std::span<const RigidBody> bodies);
 bool contact_free(const PeerScene& scene);
 /// Whether the Impetus detector lets bodies i and j touch (groups/masks both ways, joined bodies).
 bool may_collide(const PeerScene& scene, std::size_t i, std::size_t j);
+/// μ of a contact between bodies i and j as Impetus combines it: √(μ_i μ_j) (docs/conventions.md,
+/// "Friction"); 0 when either body is frictionless.
+double pair_friction(std::span<const RigidBody> bodies, std::size_t i, std::size_t j);
+/// True when some pair of bodies that may touch has μ > 0.
+bool has_friction(const PeerScene& scene);
 /// The first shape in the scene this engine cannot represent as a collision shape ("mesh"), or "".
 std::string first_mesh(const PeerScene& scene);
 
