@@ -113,6 +113,34 @@ PEER_NOTES = {
         "Each engine's own integrator drifts at first order in dt: over 20 s at 1/1000 s the angular momentum "
         "by 0.9 % (Bullet, MuJoCo) and 1.4 % (ODE), the energy by 1.7-3 %, 4-10 times more at 1/100 s; none "
         "keeps L to 1e-6 as the `momentum` integrator does by construction.",
+    "friction_slope_slide":
+        "Only ODE's dWorldStep (the Dantzig LCP; friction bounded by μ times the normal force through "
+        "dContactApprox1) slides the box at the closed form (5e-11 m/s, its CFM); ODE QuickStep ends 2e-5 to 0.06 "
+        "m/s off, differently from run to run at the same step (it reorders its rows at random from a seed that "
+        "carries over between worlds); Bullet's box ends 13 % (1/1000 s) to 45 % (1/60 s) slower than Coulomb's "
+        "law, turning and drifting sideways (one friction row per corner, each along that corner's own slip); "
+        "MuJoCo's soft friction is off by 0.02-0.15 m/s.",
+    "friction_slope_stick":
+        "Every peer lets the box that should stick creep. ODE's dWorldStep moves it 1.9e-6 m at 1/1000 s and "
+        "5e-4 m at 1/60 s, of the size of g dt² (one step before its contact exists: ODE makes a contact "
+        "only once the box sinks into the slope), then holds it; Bullet creeps 1.5e-5 m (1/1000 s) to 4 mm "
+        "(1/60 s), ODE QuickStep 0.5-9 mm, and MuJoCo's regularized friction lets the box slide on steadily "
+        "(9.5-15 mm in 5 s with both solvers).",
+    "friction_sphere_roll":
+        "A single contact is easy: Bullet and ODE reach 5/7 v0 at rounding level with μ translated exactly "
+        "(`tests/peers` checks the sliding phase too); MuJoCo's soft contact keeps a slip of 8e-4 m/s at "
+        "1/1000 s (6e-3 at 1/60).",
+    "friction_card_house":
+        "ODE's dWorldStep keeps the house standing at 1/240 s (the plank 0.6 mm off; 1.3 and 5.4 mm at 1/120 "
+        "and 1/60 s, after one LCP failure message); at the finer steps ODE QuickStep and MuJoCo Newton let the "
+        "plank slip about 2 cm and MuJoCo PGS 9-11 mm, and at 1/60 s all three lose the house (0.17-0.9 m); "
+        "under Bullet SI (10 or 100 iterations) it collapses at every step (plank 0.93-0.95 m off).",
+    "friction_pyramid_10":
+        "Every peer's pyramid collapses at every step size (top sphere 3.5-15 m away), although an equilibrium exists: the Baumgarte "
+        "push they ship (ERP 0.2) opens the spheres' initial 5e-5 m overlaps and the pyramid comes apart. "
+        "Measured aside: ODE's dWorldStep with ERP 1e-6 instead holds it (top sphere 4e-8 m off after 10 s at "
+        "1/30 s, within 3e-7 m as far as the wall-time budget let the finer steps run) but takes 20 ms per step, 100 times `ledas`; with ERP 0 its LCP gives up on the resting contacts and the "
+        "pyramid collapses as well.",
     "bracket":
         "Not run in any peer: the bracket is a non-convex triangle mesh (MuJoCo collides a mesh as its convex "
         "hull, Bullet needs GImpact for a moving concave mesh, ODE's trimesh is another contact model).",
@@ -466,7 +494,9 @@ def peer_table(suite):
     out("")
     out("From `docs/data/accuracy_peers.json` (`bench_accuracy_peers%s`, %s; %s). Each scenario's scene is "
         "loaded and built by Impetus exactly as in the suite, then translated into the engine: the same bodies, "
-        "masses, inertias, shapes, initial state and joints, frictionless, the scene's restitution. The engine "
+        "masses, inertias, shapes, initial state and joints, the scene's restitution and friction (each "
+        "engine's own friction law with the scene's μ: Bullet's one row per point, ODE's pyramid scaled by the "
+        "normal force, MuJoCo's elliptic cone). The engine "
         "steps it with the same time step for the same duration, and the suite's own probes judge the engine's "
         "body states (positions, rotations, velocities; contacts found by the Impetus detector at those "
         "positions), never what the engine reports about itself. Impacts are the suite's one-resolution "
