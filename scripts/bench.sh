@@ -36,11 +36,13 @@ run_as dynamic step --benchmark_filter='_t[0-9]+$'
 run detect
 run model
 if [ -x "$build/bin/bench_peers" ]; then
-  run peers --benchmark_filter='-/heap_'
+  run peers --benchmark_filter='-(/heap_|_mu)'
   run_as dynamic_peers peers --benchmark_filter='/heap_'
+  run_as friction_peers peers --benchmark_filter='_mu'
   mkdir -p "$root/docs/charts"
-  "$py" "$root/benchmarks/peers/report.py" "$data/peers.json" --chart "$root/docs/charts/peers.png" > "$root/docs/peers.md"
-else rm -f "$data/peers.json" "$data/dynamic_peers.json"; echo "== bench_peers not built (no Bullet/ODE/MuJoCo): skipped"; fi
+  "$py" "$root/benchmarks/peers/report.py" "$data/peers.json" --chart "$root/docs/charts/peers.png" \
+    --friction "$data/friction_peers.json" --friction-chart "$root/docs/charts/peers_friction.png" > "$root/docs/peers.md"
+else rm -f "$data/peers.json" "$data/dynamic_peers.json" "$data/friction_peers.json"; echo "== bench_peers not built (no Bullet/ODE/MuJoCo): skipped"; fi
 "$py" "$root/scripts/bench_report.py" "$data" "$root/docs"
 # Frictional contact problems in fclib's form (generated and exported; a table and a performance profile).
 run fclib

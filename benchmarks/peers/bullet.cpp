@@ -2,8 +2,12 @@
 // scenes: a btDiscreteDynamicsWorld with the same spheres and planes, stepped once with dt.
 //
 // Settings for the impulse problem: contact and friction ERP 0 and split impulse off (so the velocities
-// are the velocity solve's and nothing else), friction 0, restitution e on every body (Bullet multiplies
-// the two bodies' coefficients), no damping, no deactivation. Every reset clears the contact manifolds,
+// are the velocity solve's and nothing else), restitution e on every body (Bullet multiplies the two
+// bodies' coefficients), no damping, no deactivation. Friction (the "_mu" scenes): each body's friction
+// √μ, so that Bullet's product is the scene's μ; Bullet's friction rows as shipped (one per contact point,
+// along its slip) or with SOLVER_USE_2_FRICTION_DIRECTIONS (the `_2dir` rows: two, each clamped to ±μ p_n,
+// a box around the cone). The impulse a point applied to body A is p n_B + l1 d1 + l2 d2
+// (btManifoldPoint's applied impulses along its normal and its two lateral directions). Every reset clears the contact manifolds,
 // so no step is warm-started from the previous one.
 #include "peers.hpp"
 
@@ -12,6 +16,7 @@
 #include <BulletDynamics/MLCPSolvers/btMLCPSolver.h>
 
 #include <chrono>
+#include <cmath>
 
 static_assert(sizeof(btScalar) == sizeof(double), "bench_peers needs Bullet's double-precision build");
 
@@ -47,6 +52,7 @@ struct BulletConfig {
   double global_cfm = 0.0;    ///< regularization: Bullet adds cfm/dt to the MLCP's diagonal
   double erp = 0.0;           ///< contact ERP (Baumgarte velocity erp·depth/dt), split impulse off
   bool shipped = false;       ///< leave btContactSolverInfo as shipped (erp 0.2, split impulse on) but iterations
+  bool two_directions = false;  ///< SOLVER_USE_2_FRICTION_DIRECTIONS (off as shipped)
 };
 
 class BulletStep final : public PeerStep {
@@ -73,6 +79,7 @@ class BulletStep final : public PeerStep {
       info.m_splitImpulse = 0;
       info.m_globalCfm = config.global_cfm;
     }
+    if (config.two_directions) info.m_solverMode |= SOLVER_USE_2_FRICTION_DIRECTIONS;
     add_bodies();
   }
 
@@ -113,12 +120,20 @@ class BulletStep final : public PeerStep {
       r.velocity.push_back(from_bt(body->getLinearVelocity()));
       r.angular_velocity.push_back(from_bt(body->getAngularVelocity()));
     }
-    ContactTally tally(pairs_, scene_.contacts.size(), true);
+    ContactTally tally(pairs_, scene_.contacts, true);
     for (int m = 0; m < dispatcher_.getNumManifolds(); ++m) {
       const btPersistentManifold& manifold = *dispatcher_.getManifoldByIndexInternal(m);
       const auto i = static_cast<std::size_t>(manifold.getBody0()->getUserIndex());
       const auto j = static_cast<std::size_t>(manifold.getBody1()->getUserIndex());
-      for (int p = 0; p < manifold.getNumContacts(); ++p) tally.add(i, j, manifold.getContactPoint(p).getAppliedImpulse());
+      for (int p = 0; p < manifold.getNumContacts(); ++p) {
+        const btManifoldPoint& point = manifold.getContactPoint(p);
+        // On body 0 (A); the normal points from B to A. The second lateral impulse is 0 unless the second
+        // friction direction is on.
+        const Vec3 on_a = from_bt(point.m_normalWorldOnB * point.getAppliedImpulse() +
+                                  point.m_lateralFrictionDir1 * point.m_appliedImpulseLateral1 +
+                                  point.m_lateralFrictionDir2 * point.m_appliedImpulseLateral2);
+        tally.add(i, j, point.getAppliedImpulse(), Vec3(-on_a));
+      }
     }
     tally.finish(r);
     r.iterations = config_.iterations;
@@ -151,7 +166,7 @@ class BulletStep final : public PeerStep {
         body = std::make_unique<btRigidBody>(info);
         body->setActivationState(DISABLE_DEACTIVATION);
       }
-      body->setFriction(0.0);
+      body->setFriction(std::sqrt(b.material.friction));
       body->setRollingFriction(0.0);
       body->setSpinningFriction(0.0);
       body->setRestitution(restitution);
@@ -202,7 +217,13 @@ void add_bullet_methods(std::vector<Method>& out) {
     BulletConfig c;
     c.iterations = iterations;
     out.push_back(bullet_method("bullet_si_" + std::to_string(iterations), c, std::size_t(1) << 40));
+    out.back().friction = true;
   }
+  BulletConfig two;
+  two.iterations = 50;
+  two.two_directions = true;
+  out.push_back(bullet_method("bullet_si_50_2dir", two, std::size_t(1) << 40));
+  out.back().friction_only = out.back().friction = true;
   // The Dantzig MLCP builds a dense matrix of 2 rows per contact (normal + one friction row): pyramid 50
   // would need ~0.5 GB, so it stops at 1000 bodies.
   BulletConfig mlcp;
@@ -215,6 +236,11 @@ void add_bullet_methods(std::vector<Method>& out) {
   mlcp.erp = 1e-6;
   mlcp.global_cfm = 1e-10;  // as ODE's default
   out.push_back(bullet_method("bullet_mlcp_perturbed", mlcp, 1000));
+  out.back().friction = true;
+  BulletConfig mlcp_two = mlcp;
+  mlcp_two.two_directions = true;
+  out.push_back(bullet_method("bullet_mlcp_perturbed_2dir", mlcp_two, 1000));
+  out.back().friction_only = out.back().friction = true;
   mlcp.erp = 0.0;
   mlcp.shipped = true;
   out.push_back(bullet_method("bullet_mlcp_shipped", mlcp, 1000));

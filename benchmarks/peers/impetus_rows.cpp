@@ -32,7 +32,10 @@ class ImpetusStep final : public PeerStep {
       r.velocity.push_back(b.velocity);
       r.angular_velocity.push_back(b.angular_velocity);
     }
-    for (const Contact& c : contacts_) r.impulses.push_back(c.impulse);
+    for (const Contact& c : contacts_) {
+      r.impulses.push_back(c.impulse);
+      r.impulse_vectors.push_back(c.impulse * c.normal + c.tangent_impulse);  // on b
+    }
     r.engine_contacts = r.matched = contacts_.size();
     r.iterations = static_cast<double>(counters_.rounds);
     r.failures = static_cast<double>(counters_.non_converged);
@@ -66,8 +69,8 @@ class ImpetusWholeStep final : public PeerStep {
       r.velocity.push_back(b.velocity);
       r.angular_velocity.push_back(b.angular_velocity);
     }
-    ContactTally tally(pairs_, scene_.contacts.size(), true);
-    for (const Contact& c : world_.contacts()) tally.add(c.a, c.b, c.impulse);
+    ContactTally tally(pairs_, scene_.contacts, true);
+    for (const Contact& c : world_.contacts()) tally.add(c.a, c.b, c.impulse, c.impulse * c.normal + c.tangent_impulse);
     tally.finish(r);
     r.iterations = static_cast<double>(last_.resolver.rounds);
     r.failures = static_cast<double>(last_.resolver.non_converged);
@@ -97,6 +100,7 @@ void add_impetus_methods(std::vector<Method>& out) {
     m.name = "impetus_" + resolver;
     // The paper's round-by-round mode takes seconds to minutes beyond pyramid 20 (bench_resolve has those).
     if (resolver == "ledas_paper") m.max_bodies = 210;
+    m.friction = resolver != "ledas_paper";  // the paper's mode refuses friction
     m.make = [resolver](const bench::PreparedScene& scene, const StepSettings&) {
       return std::make_unique<ImpetusStep>(scene, resolver);
     };

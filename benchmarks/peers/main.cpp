@@ -16,10 +16,19 @@
 //   exact                   e = 0: residual ≤ 1e-9 m/s and complementarity ≤ 1e-9 N·m/s;
 //                           e = 1: residual ≤ 1e-9 m/s and |energy_change| ≤ 1e-9 (as bench_resolve)
 //   solver_ms               the engine's solver alone, mean per step (NaN where it cannot be separated)
+// With friction (scenes "…_muX", every body's μ = X):
+//   natural_map             fclib's natural-map error, unscaled: the 2-norm over contacts of
+//                           r − P_K(r − (u_n + μ‖u_t‖, u_t)), r the engine's own impulse on the contact (normal
+//                           and friction) and u the relative velocity its step left, in the contact's frame
+//   impulse_mismatch        max over bodies of |m (v⁺ − v⁻ − g dt) − Σ impulses| (N·s): whether the impulses
+//                           the engine reports are the ones it applied
+//   exact                   natural_map ≤ 1e-9 and residual ≤ 1e-9 (as bench_resolve)
 #include "peers.hpp"
 
 #include "support/bench_dynamic.hpp"
 #include "support/bench_main.hpp"
+
+#include "impetus/fclib/fclib.hpp"
 
 #include <benchmark/benchmark.h>
 
@@ -36,8 +45,46 @@ using namespace impetus;
 using namespace impetus::peers;
 
 
+/// The natural-map error of the engine's impulses and the velocities its step left (see the counters
+/// above), and how far its reported impulses are from the momentum its bodies gained.
+struct FrictionQuality {
+  double natural_map = kNaN, impulse_mismatch = kNaN;
+};
+
+FrictionQuality friction_quality(const bench::PreparedScene& prepared, std::span<const RigidBody> after,
+                                 const StepResult& r, const StepSettings& settings) {
+  FrictionQuality q;
+  if (r.impulse_vectors.size() != prepared.contacts.size()) return q;
+  const std::span<const RigidBody> before = prepared.bodies;
+  std::vector<Vec3> received(before.size(), Vec3::Zero());
+  double sum = 0.0;
+  for (std::size_t k = 0; k < prepared.contacts.size(); ++k) {
+    const Contact& c = prepared.contacts[k];
+    const Vec3& impulse = r.impulse_vectors[k];  // on b
+    received[c.b] += impulse;
+    received[c.a] -= impulse;
+    // Relative velocity of b with respect to a at the contact point, at the initial positions (the
+    // impulse problem's); a gap that the step may close counts as fclib's w (fclib.hpp, scene_problem).
+    const Vec3 u = after[c.b].velocity_at(c.point) - after[c.a].velocity_at(c.point);
+    Vec3 t1, t2;
+    tangent_basis(c.normal, t1, t2);
+    const Vec3 r_local(impulse.dot(c.normal), impulse.dot(t1), impulse.dot(t2));
+    const Vec3 u_local(u.dot(c.normal) - std::min(0.0, c.depth) / settings.dt, u.dot(t1), u.dot(t2));
+    sum += fclib::natural_map(r_local, u_local, combined_friction(before[c.a], before[c.b])).squaredNorm();
+  }
+  q.natural_map = std::sqrt(sum);
+  q.impulse_mismatch = 0.0;
+  for (std::size_t i = 0; i < before.size(); ++i) {
+    if (before[i].fixed) continue;
+    const Vec3 gained = before[i].mass * (after[i].velocity - before[i].velocity - settings.gravity * settings.dt);
+    q.impulse_mismatch = std::max(q.impulse_mismatch, (gained - received[i]).norm());
+  }
+  return q;
+}
+
 /// Copies the peer's post-step velocities into a copy of the Impetus bodies and measures them.
-void report(benchmark::State& state, const bench::PreparedScene& prepared, const StepResult& r, bool inelastic) {
+void report(benchmark::State& state, const bench::PreparedScene& prepared, const StepResult& r, bool inelastic,
+            const StepSettings& settings) {
   std::vector<RigidBody> after = prepared.bodies;
   for (std::size_t i = 0; i < after.size(); ++i) {
     if (after[i].fixed) continue;
@@ -64,6 +111,12 @@ void report(benchmark::State& state, const bench::PreparedScene& prepared, const
   const bool exact = q.approach <= 1e-9 && (inelastic ? complementarity <= 1e-9 : std::abs(q.energy_change) <= 1e-9);
   state.counters["exact"] = exact ? 1.0 : 0.0;
   state.counters["solver_ms"] = 1e3 * r.solver_seconds;
+  if (bench::key_friction(prepared.name) > 0.0) {
+    const FrictionQuality f = friction_quality(prepared, after, r, settings);
+    state.counters["natural_map"] = f.natural_map;
+    state.counters["impulse_mismatch"] = f.impulse_mismatch;
+    state.counters["exact"] = f.natural_map <= 1e-9 && q.approach <= 1e-9 ? 1.0 : 0.0;
+  }
 }
 
 /// The dynamic scene `family`_`n` (support/bench_dynamic.hpp): its snapshot, and the contacts Impetus's
@@ -97,7 +150,7 @@ void run(benchmark::State& state, const Method& method, const bench::PreparedSce
     state.ResumeTiming();
     peer->step();
   }
-  report(state, prepared, peer->result(), !prepared.name.ends_with("_e1"));
+  report(state, prepared, peer->result(), !prepared.name.ends_with("_e1"), settings);
 }
 
 std::vector<Method>& methods() {
@@ -127,12 +180,18 @@ void register_all() {
     scenes.emplace_back("line_" + std::to_string(n) + "_e0", n);
     scenes.emplace_back("line_" + std::to_string(n) + "_e1", n);
   }
+  // With friction (every body's μ; bench_resolve has the same scenes): the dropped pyramid where every
+  // contact can stick (0.7) and where the supports slide (0.5).
+  for (const char* mu : {"0.7", "0.5"})
+    for (int k : {3, 10, 20}) scenes.emplace_back("pyramid_" + std::to_string(k) + "_mu" + mu, k * (k + 1) / 2);
   StepSettings gravity;
   gravity.gravity = Vec3(0.0, 0.0, -9.81);
   for (const Method& method : methods()) {
     for (const auto& [key, bodies] : scenes) {
       if (bodies > max_bodies || bodies > method.max_bodies || method.gravity_only) continue;
       if (key.ends_with("_e1") && !method.restitution) continue;
+      const bool frictional = bench::key_friction(key) > 0.0;
+      if (frictional ? !method.friction : method.friction_only) continue;
       benchmark::RegisterBenchmark(("peers/" + method.name + "/" + key).c_str(),
                                    [&method, key](benchmark::State& st) {
                                      run(st, method, bench::prepared_scene(key), StepSettings{});

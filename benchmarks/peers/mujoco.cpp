@@ -1,6 +1,7 @@
 // MuJoCo on the peers' scenes: a model built from an MJCF string (loaded through a virtual file system):
 // one free body per sphere (geom sphere, mass 1, so inertia 2/5 m r² as Impetus), the fixed plane as a
-// world geom, every geom condim = 1 (frictionless), Euler integrator, dt, gravity as set; solver PGS, CG or
+// world geom, every geom condim = 1 (frictionless; with friction, the "_mu" scenes: condim 3, friction
+// "μ 0 0" — sliding only — and elliptic cones, or pyramidal ones in the `_pyramidal` rows), Euler integrator, dt, gravity as set; solver PGS, CG or
 // Newton with iterations 100 and tolerance 1e-10. One mj_step from mj_resetData (no warm start).
 //
 // MuJoCo's contacts are soft (DESIGN of MuJoCo, "solver parameters"): the solve gives J a = d·a_ref with
@@ -33,6 +34,7 @@ struct MujocoConfig {
   bool stiff = false;
   int iterations = 100;
   double tolerance = 1e-10;
+  bool pyramidal = false;  ///< pyramidal friction cones (MuJoCo's default), else elliptic
 };
 
 std::string vec(const Vec3& v) {
@@ -48,12 +50,18 @@ std::string make_mjcf(const bench::PreparedScene& scene, const StepSettings& set
   x.precision(17);
   // MuJoCo 2.2 allocates dense njmax × nv and njmax × njmax arrays: size them for the contacts the Impetus
   // detector found (+10 %), not generously, or pyramid 50 cannot allocate its mjData.
-  const std::size_t capacity = scene.contacts.size() + scene.contacts.size() / 10 + 20;
+  // A frictional contact has 3 rows (elliptic cone) or 4 (pyramidal: 2 per tangent direction).
+  const std::size_t rows = scene.bodies.front().material.friction > 0 ? 4 : 1;
+  const std::size_t capacity = rows * (scene.contacts.size() + scene.contacts.size() / 10) + 20;
   x << "<mujoco model=\"peers\">\n"
     << "  <size nconmax=\"" << capacity << "\" njmax=\"" << capacity << "\"/>\n"
     << "  <option timestep=\"" << settings.dt << "\" gravity=\"" << vec(settings.gravity)
-    << "\" integrator=\"Euler\"/>\n"
-    << "  <default><geom condim=\"1\"";
+    << "\" integrator=\"Euler\" cone=\"" << (config.pyramidal ? "pyramidal" : "elliptic") << "\"/>\n";
+  const double mu = scene.bodies.front().material.friction;  // every body's (bench_scenes.hpp)
+  if (mu > 0)
+    x << "  <default><geom condim=\"3\" friction=\"" << mu << " 0 0\"";
+  else
+    x << "  <default><geom condim=\"1\"";
   if (config.stiff) x << " solref=\"0 " << -1.0 / settings.dt << "\" solimp=\"0.9999 0.9999 0.001 0.5 2\"";
   x << "/></default>\n  <worldbody>\n";
   const double radius = sphere_radius(scene);
@@ -122,12 +130,19 @@ class MujocoStep final : public PeerStep {
       r.velocity.push_back(Vec3(v[0], v[1], v[2]));
       r.angular_velocity.push_back(Vec3(v[3], v[4], v[5]));  // body frame = world frame (identity pose)
     }
-    ContactTally tally(pairs_, scene_.contacts.size(), true);
+    ContactTally tally(pairs_, scene_.contacts, true);
     for (int c = 0; c < data_->ncon; ++c) {
       const mjContact& contact = data_->contact[c];
-      // condim 1: one constraint row, the normal force (N); its impulse over the step is force·dt.
-      tally.add(impetus_body(contact.geom1), impetus_body(contact.geom2),
-                data_->efc_force[contact.efc_address] * settings_.dt);
+      // The contact force in its frame (normal, then the two tangents; mj_contactForce also converts a
+      // pyramidal cone's edge forces), exerted by geom 1 on geom 2 along the normal from 1 to 2; times dt,
+      // the impulse over the step.
+      mjtNum f[6];
+      mj_contactForce(model_, data_, c, f);
+      const Vec3 on_2 = f[0] * Vec3(contact.frame[0], contact.frame[1], contact.frame[2]) +
+                        f[1] * Vec3(contact.frame[3], contact.frame[4], contact.frame[5]) +
+                        f[2] * Vec3(contact.frame[6], contact.frame[7], contact.frame[8]);
+      tally.add(impetus_body(contact.geom1), impetus_body(contact.geom2), f[0] * settings_.dt,
+                Vec3(settings_.dt * on_2));
     }
     tally.finish(r);
     r.iterations = data_->solver_iter;
@@ -176,7 +191,16 @@ void add_mujoco_methods(std::vector<Method>& out) {
       // Newton factors a dense nv × nv Hessian: pyramid 50 (nv = 7650) takes ~1 s (default) to ~24 s (stiff).
       const std::size_t max_bodies = solver == mjSOL_NEWTON ? 1000 : std::size_t(1) << 40;
       out.push_back(mujoco_method(std::string("mujoco_") + name + (stiff ? "_stiff" : ""), c, max_bodies));
+      out.back().friction = solver != mjSOL_CG;
     }
+  }
+  // Newton with MuJoCo's default pyramidal cones, on the frictional scenes only (elsewhere the cone is moot).
+  for (const bool stiff : {false, true}) {
+    MujocoConfig c;
+    c.stiff = stiff;
+    c.pyramidal = true;
+    out.push_back(mujoco_method(std::string("mujoco_newton") + (stiff ? "_stiff" : "") + "_pyramidal", c, 1000));
+    out.back().friction = out.back().friction_only = true;
   }
 }
 

@@ -3,8 +3,11 @@
 // dCollide in the usual near callback, one dWorldStep (Dantzig LCP) or dWorldQuickStep (projected SOR).
 //
 // Settings: world ERP 0 (no Baumgarte velocity) unless a row says otherwise, contact surface layer 0,
-// mu = 0, bounce = e with bounce_vel 0 for e > 0, world CFM as configured (contacts use it: no
-// dContactSoftCFM). ODE's LCP errors ("LCP internal error, s <= 0") arrive through dMessage: a handler
+// bounce = e with bounce_vel 0 for e > 0, world CFM as configured (contacts use it: no dContactSoftCFM).
+// Friction (the "_mu" scenes): mu = the scene's μ with dContactApprox1, so that each of ODE's two friction
+// directions is bounded by μ times the contact's normal force (a pyramid around the cone); without
+// dContactApprox1 ODE's mu is a force bound in newtons, not a coefficient. The impulse on body 1 is its
+// dJointFeedback force f1 times dt. ODE's LCP errors ("LCP internal error, s <= 0") arrive through dMessage: a handler
 // counts them as failures.
 #include "ode_support.hpp"
 #include "peers.hpp"
@@ -85,13 +88,14 @@ class OdeStep final : public PeerStep {
       r.velocity.push_back(v ? Vec3(v[0], v[1], v[2]) : Vec3::Zero());
       r.angular_velocity.push_back(w ? Vec3(w[0], w[1], w[2]) : Vec3::Zero());
     }
-    ContactTally tally(pairs_, scene_.contacts.size(), true);
+    ContactTally tally(pairs_, scene_.contacts, true);
     for (std::size_t k = 0; k < feedback_.size(); ++k) {
       // Body 1 is always the sphere (near_callback orders the geoms) and the normal points into it, so
       // the force ODE applied to body 1 along the normal, times dt, is the contact's impulse.
       const ContactPair& c = contact_pairs_[k];
       const dReal* f = feedback_[k].f1;
-      tally.add(c.i, c.j, (f[0] * c.normal.x() + f[1] * c.normal.y() + f[2] * c.normal.z()) * settings_.dt);
+      tally.add(c.i, c.j, (f[0] * c.normal.x() + f[1] * c.normal.y() + f[2] * c.normal.z()) * settings_.dt,
+                Vec3(-settings_.dt * Vec3(f[0], f[1], f[2])));
     }
     tally.finish(r);
     r.iterations = config_.quick ? config_.iterations : 0;
@@ -115,8 +119,8 @@ class OdeStep final : public PeerStep {
     const int n = dCollide(g1, g2, 4, &contacts[0].geom, sizeof(dContact));
     for (int k = 0; k < n; ++k) {
       dContact& c = contacts[k];
-      c.surface.mode = self.restitution_ > 0 ? dContactBounce : 0;
-      c.surface.mu = 0.0;
+      c.surface.mode = (self.restitution_ > 0 ? dContactBounce : 0) | (self.friction_ > 0 ? dContactApprox1 : 0);
+      c.surface.mu = self.friction_;
       c.surface.bounce = self.restitution_;
       c.surface.bounce_vel = 0.0;
       const dJointID joint = dJointCreateContact(self.world_, self.joints_, &c);
@@ -129,6 +133,7 @@ class OdeStep final : public PeerStep {
 
   void add_bodies() {
     restitution_ = scene_.bodies.front().material.restitution;
+    friction_ = scene_.bodies.front().material.friction;  // every body's (bench_scenes.hpp)
     const double radius = sphere_radius(scene_);
     for (std::size_t i = 0; i < scene_.bodies.size(); ++i) {
       const RigidBody& b = scene_.bodies[i];
@@ -162,7 +167,7 @@ class OdeStep final : public PeerStep {
   std::vector<dBodyID> bodies_;             ///< per Impetus body; null for the fixed plane
   std::deque<dJointFeedback> feedback_;     ///< per contact joint (a deque: ODE keeps pointers into it)
   std::vector<ContactPair> contact_pairs_;  ///< per contact joint
-  double restitution_ = 0.0;
+  double restitution_ = 0.0, friction_ = 0.0;
   double solver_seconds_ = 0.0;
   long steps_ = 0;
 };
@@ -192,6 +197,7 @@ void add_ode_methods(std::vector<Method>& out) {
   out.push_back(ode_method("ode_worldstep_cfm0", exact, 1000));
   exact.cfm = 1e-10;  // as shipped (double precision)
   out.push_back(ode_method("ode_worldstep", exact, 1000));
+  out.back().friction = true;
   exact.cfm = 1e-8;  // regularized
   out.push_back(ode_method("ode_worldstep_cfm", exact, 1000));
   // Neither CFM helps a contact that touches with exactly zero normal velocity (the Dantzig ratio test
@@ -199,6 +205,7 @@ void add_ode_methods(std::vector<Method>& out) {
   exact.cfm = 1e-10;
   exact.erp = 1e-6;
   out.push_back(ode_method("ode_worldstep_perturbed", exact, 1000));
+  out.back().friction = true;
   exact.erp = 0.2;  // everything as shipped: Baumgarte pushes the overlapping spheres apart
   out.push_back(ode_method("ode_worldstep_shipped", exact, 1000));
   for (int iterations : {10, 20, 50, 200}) {
@@ -206,6 +213,7 @@ void add_ode_methods(std::vector<Method>& out) {
     quick.quick = true;
     quick.iterations = iterations;
     out.push_back(ode_method("ode_quickstep_" + std::to_string(iterations), quick, std::size_t(1) << 40));
+    out.back().friction = iterations == 20 || iterations == 200;
   }
 }
 

@@ -34,6 +34,10 @@ struct StepResult {
   /// Normal impulse the engine applied at each Impetus contact (N·s), summed over the engine's contact
   /// points on the same pair of bodies; empty when the engine exposes none (complementarity is NaN then).
   std::vector<double> impulses;
+  /// The whole impulse (normal and friction, N·s, world frame) the engine applied to body b of each Impetus
+  /// contact (−it to a; modules/contact.hpp's convention), summed like `impulses`; empty when the engine
+  /// exposes no friction impulse (the natural-map error is NaN then).
+  std::vector<Vec3> impulse_vectors;
   std::size_t engine_contacts = 0;      ///< contact points the engine generated and solved
   std::size_t matched = 0;              ///< Impetus contacts with at least one engine point on their pair
   std::size_t extra = 0;                ///< engine points on a pair the Impetus detector has no contact for
@@ -60,6 +64,9 @@ struct Method {
   std::string name;
   /// false: skip the e = 1 line rows (the engine has no Newton restitution to compare).
   bool restitution = true;
+  /// true: also run on the frictional scenes (main.cpp: the engine's friction with the scene's μ);
+  /// friction_only: only there (a setting that differs from another method only in its friction).
+  bool friction = false, friction_only = false;
   /// Largest scene (movable bodies) this method is run on; dense direct solvers grow as n³.
   std::size_t max_bodies = std::size_t(1) << 40;
   /// true: a whole Impetus step (detection, resolve, integration), run only on the rows under gravity.
@@ -99,21 +106,22 @@ class PairIndex {
 };
 
 /// Collects an engine's contact points into a StepResult: each point on Impetus bodies (i, j) with the
-/// normal impulse `impulse` (N·s; NaN when unknown) is added to the matching Impetus contact.
+/// normal impulse `impulse` (N·s; NaN when unknown), and if the engine reports it the whole impulse on j
+/// (world frame), is added to the matching Impetus contact.
 class ContactTally {
  public:
-  ContactTally(const PairIndex& pairs, std::size_t contact_count, bool impulses_known)
-      : pairs_(pairs), impulses_(contact_count, 0.0), hit_(contact_count, false), known_(impulses_known) {}
+  ContactTally(const PairIndex& pairs, const std::vector<Contact>& contacts, bool impulses_known)
+      : pairs_(pairs), contacts_(contacts), impulses_(contacts.size(), 0.0),
+        vectors_(contacts.size(), Vec3::Zero()), hit_(contacts.size(), false), known_(impulses_known) {}
 
   void add(std::size_t i, std::size_t j, double impulse) {
-    ++points_;
-    const long k = pairs_.find(i, j);
-    if (k < 0) {
-      ++extra_;
-      return;
-    }
-    hit_[static_cast<std::size_t>(k)] = true;
-    impulses_[static_cast<std::size_t>(k)] += impulse;
+    vectors_known_ = false;
+    add_point(i, j, impulse);
+  }
+  /// With the whole impulse `on_j` the engine applied to body j at this point.
+  void add(std::size_t i, std::size_t j, double impulse, const Vec3& on_j) {
+    const long k = add_point(i, j, impulse);
+    if (k >= 0) vectors_[static_cast<std::size_t>(k)] += contacts_[static_cast<std::size_t>(k)].b == j ? on_j : Vec3(-on_j);
   }
 
   /// Writes the counts and impulses into `out`.
@@ -122,13 +130,28 @@ class ContactTally {
     out.extra = extra_;
     out.matched = static_cast<std::size_t>(std::count(hit_.begin(), hit_.end(), true));
     if (known_) out.impulses = std::move(impulses_);
+    if (known_ && vectors_known_) out.impulse_vectors = std::move(vectors_);
   }
 
  private:
+  long add_point(std::size_t i, std::size_t j, double impulse) {
+    ++points_;
+    const long k = pairs_.find(i, j);
+    if (k < 0) {
+      ++extra_;
+      return k;
+    }
+    hit_[static_cast<std::size_t>(k)] = true;
+    impulses_[static_cast<std::size_t>(k)] += impulse;
+    return k;
+  }
+
   const PairIndex& pairs_;
+  const std::vector<Contact>& contacts_;
   std::vector<double> impulses_;
+  std::vector<Vec3> vectors_;
   std::vector<bool> hit_;
-  bool known_;
+  bool known_, vectors_known_ = true;
   std::size_t points_ = 0, extra_ = 0;
 };
 

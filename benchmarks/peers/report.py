@@ -34,8 +34,12 @@ def fmt(x):
     return f"{x:.3g}" if 1e-3 <= abs(x) < 1e4 else f"{x:.1e}"
 
 
+def scene_key(s):
+    return (s.split("_")[0], int(s.split("_")[1]), s)
+
+
 def table(rows):
-    scenes = sorted({s for _, s in rows}, key=lambda s: (s.split("_")[0], int(s.split("_")[1]), s))
+    scenes = sorted({s for _, s in rows if "_mu" not in s}, key=scene_key)
     out = ["| method | scene | contacts (engine) | cpu ms | wall ms | solver ms | residual m/s | complementarity | energy change | failures | exact |",
            "|---|---|---|---|---|---|---|---|---|---|---|"]
     for method in dict.fromkeys(m for m, _ in rows):
@@ -48,6 +52,59 @@ def table(rows):
                 fmt(b["real_time"]), fmt(b.get("solver_ms")), fmt(b["residual"]), fmt(b["complementarity"]),
                 fmt(b["energy_change"]), int(b["failures"]), int(b["exact"])))
     return "\n".join(out)
+
+
+FRICTION_INTRO = """## With friction: the same contact problem, judged by the natural-map error
+
+The dropped pyramids of the table above with every body's μ = 0.7 (every contact can stick) or 0.5 (the
+supports slide), gravity off, one step: each engine's own friction law with that μ (Bullet: one friction
+row per contact point along its slip as shipped, two in the `_2dir` rows; ODE: two directions each bounded
+by μ times the normal force, `dContactApprox1`; MuJoCo: condim 3, elliptic cones, pyramidal ones in the
+`_pyramidal` rows). Each is judged by fclib's natural-map error of its own impulses (normal and friction,
+read from the engine: Bullet's applied normal and lateral impulses, ODE's joint feedback force × dt,
+MuJoCo's `mj_contactForce` × dt) and the relative velocities its step left, in each contact's frame
+(unscaled: the error ledas's frictional solver drives below 1e-9 by Coulomb's law). `impulse mismatch` is
+the largest difference between a body's momentum change and the impulses the engine reports on it: near
+rounding everywhere, so the impulses read are the ones applied. exact: natural-map error ≤ 1e-9 and
+residual ≤ 1e-9 m/s (as `bench_resolve`)."""
+
+
+def friction_table(rows):
+    scenes = sorted({s for _, s in rows if "_mu" in s}, key=lambda s: (s.split("_mu")[1], scene_key(s)))
+    out = [FRICTION_INTRO, "",
+           "| method | scene | contacts (engine) | cpu ms | solver ms | natural-map error | residual m/s | impulse mismatch N·s | failures | exact |",
+           "|---|---|---|---|---|---|---|---|---|---|"]
+    for scene in scenes:
+        for method in dict.fromkeys(m for m, _ in rows):
+            b = rows.get((method, scene))
+            if not b:
+                continue
+            out.append("| {} | {} | {} ({}) | {} | {} | {} | {} | {} | {} | {} |".format(
+                method, scene, int(b["contacts"]), int(b["engine_contacts"]), fmt(b["cpu_time"]),
+                fmt(b.get("solver_ms")), fmt(b.get("natural_map")), fmt(b["residual"]),
+                fmt(b.get("impulse_mismatch")), int(b["failures"]), int(b["exact"])))
+    return "\n".join(out)
+
+
+def friction_chart(rows, path, scene):
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    fig, ax = plt.subplots(figsize=(9, 6))
+    for (method, s), b in rows.items():
+        if s != scene:
+            continue
+        error = max(b.get("natural_map", float("nan")), 1e-17)
+        ax.scatter(b["cpu_time"], error)
+        ax.annotate(method, (b["cpu_time"], error), fontsize=7)
+    ax.set_xscale("log")
+    ax.set_yscale("log")
+    ax.set_xlabel("CPU time per step (engines) or solve (Impetus), ms, median")
+    ax.set_ylabel("natural-map error of the engine's impulses and velocities")
+    ax.set_title(f"bench_peers with friction, {scene}")
+    ax.axhline(1e-9, color="grey", linestyle=":", linewidth=1)
+    fig.tight_layout()
+    fig.savefig(path, dpi=120)
 
 
 def chart(rows, path, scene):
@@ -81,6 +138,9 @@ def main():
     p.add_argument("json")
     p.add_argument("--chart", help="write a PNG: CPU time against residual")
     p.add_argument("--scene", default="pyramid_20", help="scene for the chart (default pyramid_20)")
+    p.add_argument("--friction", help="a second bench_peers JSON with the frictional rows (…_muX scenes)")
+    p.add_argument("--friction-chart", help="write a PNG: CPU time against natural-map error")
+    p.add_argument("--friction-scene", default="pyramid_10_mu0.7", help="scene for that chart")
     args = p.parse_args()
     rows = load(args.json)
     if not rows:
@@ -89,6 +149,12 @@ def main():
     print(table(rows))
     if args.chart:
         chart(rows, args.chart, args.scene)
+    friction = load(args.friction) if args.friction else {k: v for k, v in rows.items() if "_mu" in k[1]}
+    if friction:
+        print()
+        print(friction_table(friction))
+        if args.friction_chart:
+            friction_chart(friction, args.friction_chart, args.friction_scene)
 
 
 if __name__ == "__main__":

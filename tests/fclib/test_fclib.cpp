@@ -205,6 +205,24 @@ TEST(Fclib, FclibsMeritIsTheNaturalMapResidualScaledAsFclibScalesIt) {
   }
 }
 
+
+// One contact's natural map (the measure bench_peers applies to other engines' impulses and velocities) is
+// zero exactly on Coulomb's three cases and measures the distance from them otherwise (μ = 0.5).
+TEST(Fclib, OneContactsNaturalMapVanishesExactlyOnCoulombsCases) {
+  const double mu = 0.5;
+  using V = Eigen::Vector3d;
+  // Separating with no impulse; sticking with the impulse inside the cone; sliding with the impulse on the
+  // cone's edge, opposite the slip.
+  EXPECT_EQ(fclib::natural_map(V(0, 0, 0), V(0.3, 0.1, -0.2), mu).norm(), 0.0);
+  EXPECT_NEAR(fclib::natural_map(V(1.0, 0.2, -0.1), V(0, 0, 0), mu).norm(), 0.0, 1e-15);
+  EXPECT_NEAR(fclib::natural_map(V(1.0, -0.3, -0.4), V(0, 0.6, 0.8), mu).norm(), 0.0, 1e-15);
+  // Not Coulomb: an impulse while separating (the impulse itself is the error), an impulse outside the
+  // cone at rest, friction along the slip instead of against it, an approach left with no impulse.
+  EXPECT_NEAR(fclib::natural_map(V(0.2, 0, 0), V(1.0, 0, 0), mu).norm(), 0.2, 1e-15);
+  EXPECT_GT(fclib::natural_map(V(1.0, 0.8, 0), V(0, 0, 0), mu).norm(), 0.1);
+  EXPECT_GT(fclib::natural_map(V(1.0, 0.3, 0.4), V(0, 0.6, 0.8), mu).norm(), 0.5);
+  EXPECT_NEAR(fclib::natural_map(V(0, 0, 0), V(-0.7, 0, 0), mu).norm(), 0.7, 1e-15);
+}
 // A problem with equality rows (fclib's mixed form V, R, s) keeps them through the file, and a joint
 // row holds (u = 0) in the solution: two unit masses, one contact and one equality row between them.
 TEST(Fclib, MixedRowsSurviveTheFileAndHoldInTheSolution) {

@@ -37,14 +37,17 @@ Eigen::Vector3d project_on_cone(const Eigen::Vector3d& y, double mu) {
 
 }  // namespace
 
+Eigen::Vector3d natural_map(const Eigen::Vector3d& r, const Eigen::Vector3d& u, double mu) {
+  const Eigen::Vector3d shifted(u(0) + mu * std::hypot(u(1), u(2)), u(1), u(2));
+  return r - project_on_cone(r - shifted, mu);
+}
+
 double natural_map_residual(const LocalProblem& problem, const Vector& r) {
   const Vector u = problem.w * r + problem.q;
   double sum = 0.0;
   for (std::size_t c = 0; c < problem.contacts(); ++c) {
     const auto i = static_cast<Eigen::Index>(3 * c);
-    const Eigen::Vector3d rc = r.segment<3>(i), uc = u.segment<3>(i);
-    const Eigen::Vector3d shifted(uc(0) + problem.mu[c] * std::hypot(uc(1), uc(2)), uc(1), uc(2));
-    sum += (rc - project_on_cone(rc - shifted, problem.mu[c])).squaredNorm();
+    sum += natural_map(r.segment<3>(i), u.segment<3>(i), problem.mu[c]).squaredNorm();
   }
   sum += u.tail(static_cast<Eigen::Index>(problem.equalities)).squaredNorm();
   return std::sqrt(sum);

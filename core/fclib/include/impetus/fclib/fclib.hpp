@@ -98,6 +98,12 @@ double merit(const LocalProblem& problem, const Vector& r);
 /// contacts of r − P_K(r − û) and over equality rows of u, with u = W r + q.
 double natural_map_residual(const LocalProblem& problem, const Vector& r);
 
+/// One contact's natural-map residual vector r − P_K(r − û), û = (u_n + μ‖u_t‖, u_t), for an impulse r and
+/// a relative velocity u in the contact's frame (normal first): zero exactly when (r, u) satisfies Coulomb's
+/// law at that contact. natural_map_residual is the 2-norm of these over the contacts (u = W r + q there);
+/// a caller with r and u from elsewhere (another engine's impulses and velocities) sums them itself.
+Eigen::Vector3d natural_map(const Eigen::Vector3d& r, const Eigen::Vector3d& u, double mu);
+
 /// The contact problem of `contacts` on `bodies` as `impetus resolve` sees it, for a step of `dt` (s): the
 /// movable bodies touched by a contact (in index order) and every contact with at least one of them;
 /// f = M v⁻ (the bodies' current velocities), w = −min(0, depth)/dt on normal rows (a gap may close
