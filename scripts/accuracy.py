@@ -126,6 +126,22 @@ PEER_NOTES = {
         "only once the box sinks into the slope), then holds it; Bullet creeps 1.5e-5 m (1/1000 s) to 4 mm "
         "(1/60 s), ODE QuickStep 0.5-9 mm, and MuJoCo's regularized friction lets the box slide on steadily "
         "(9.5-15 mm in 5 s with both solvers).",
+    "friction_slope_diagonal":
+        "The isotropy test: ODE's box does not move at all (0.66 m/s short, with dWorldStep and QuickStep), "
+        "since each of its two friction directions, along x and y, is bounded by μ N separately and the "
+        "diagonal pull (3.47 N per axis) stays under μ N cos 30° = 4.25 N in each, although its length "
+        "(4.9 N) is over Coulomb's bound; Bullet, whose friction row follows the slip, comes within 3.5e-5 "
+        "m/s with 100 iterations at 1/1000 s (1.2e-3 with 10, 0.02-0.05 at coarser steps); MuJoCo's soft "
+        "friction is 0.03-0.3 m/s off.",
+    "friction_ramp":
+        "ODE's dWorldStep meets every box's closed form at 1/240 and 1/1000 s (1.2e-10 m/s; 1.5e-4 at 1/60 s); "
+        "QuickStep is 1.5-5.6e-3 m/s off and Bullet 0.13-0.74 m/s (its boxes slide too slowly, as on the "
+        "single slope); MuJoCo refuses the scene, whose boxes have different μ (it would give each contact "
+        "the larger one).",
+    "friction_stack_10":
+        "Only ODE's dWorldStep keeps the top box within 1 mm, at 1/240 s (0.5 mm; 5-55 mm at the coarser "
+        "steps, with an LCP failure message); Bullet, ODE QuickStep and MuJoCo Newton leave it 6-14 mm off "
+        "even at 1/240 s, and MuJoCo PGS throws the stack over (10 m, with constraint-buffer warnings).",
     "friction_sphere_roll":
         "A single contact is easy: Bullet and ODE reach 5/7 v0 at rounding level with μ translated exactly "
         "(`tests/peers` checks the sliding phase too); MuJoCo's soft contact keeps a slip of 8e-4 m/s at "
@@ -159,6 +175,16 @@ WHY = {
         "The leaning cards and the plank are held by frictional contacts that must all hold at once; one "
         "sequential collision at a time never settles them. Without a cap the sweep runs past the suite's "
         "time budget; with 100 impulses per step it hits the cap in 995 steps and the plank slides 0.9 m.",
+    ("friction_slope_diagonal", "mirtich"):
+        "The four sequential corner collisions of the box sliding along x, along the diagonal: 4.9e-4 m/s "
+        "off the closed form at 1/1000 s, 8e-3 at 1/60 s.",
+    ("friction_ramp", "mirtich"):
+        "Each box's four corners share its friction one collision at a time: the sliding boxes end up to "
+        "6.5e-3 m/s (1/1000 s) and 0.1 m/s (1/60 s) off their closed forms.",
+    ("friction_stack_10", "mirtich"):
+        "The frictional stack holds for a while but the sweep needs thousands of impulses per step (40-65 ms "
+        "per step): every run stops at the 10 s wall-time budget with the top box 0.05-0.8 mm off, and with "
+        "100 impulses per step the stack falls (9 m).",
     ("friction_pyramid_10", "mirtich"):
         "55 spheres held by friction in a pyramid: the sequential sweep hits its cap in 45 of 600 steps and "
         "the pyramid spreads (top sphere 7.8 m off at 1/60 s), as the frictionless stacks above creep.",

@@ -280,24 +280,30 @@ std::unique_ptr<Probe> resting_probe(const std::string& top, std::optional<Vec3>
 std::unique_ptr<Probe> joint_gap_probe() { return std::make_unique<JointGap>(); }
 class Velocity final : public Probe {
  public:
-  Velocity(std::string body, std::function<Vec3(double)> expected, double radius)
-      : body_(std::move(body)), expected_(std::move(expected)), radius_(radius) {}
+  Velocity(std::vector<ExpectedVelocity> bodies, double radius) : bodies_(std::move(bodies)), radius_(radius) {}
   Errors finish(const World& world, double simulated) override {
-    const RigidBody& b = body_named(world, body_);
-    Errors out{{"velocity_error", (b.velocity - expected_(simulated)).norm()}};
-    if (radius_ > 0.0) out["rolling_error"] = (b.velocity + b.angular_velocity.cross(Vec3(0, 0, -radius_))).norm();
+    double error = 0.0;
+    for (const auto& [name, expected] : bodies_)
+      error = std::max(error, (body_named(world, name).velocity - expected(simulated)).norm());
+    Errors out{{"velocity_error", error}};
+    if (radius_ > 0.0) {
+      const RigidBody& b = body_named(world, bodies_.front().first);
+      out["rolling_error"] = (b.velocity + b.angular_velocity.cross(Vec3(0, 0, -radius_))).norm();
+    }
     return out;
   }
 
  private:
-  std::string body_;
-  std::function<Vec3(double)> expected_;
+  std::vector<ExpectedVelocity> bodies_;
   double radius_;
 };
 
 std::unique_ptr<Probe> tumble_probe() { return std::make_unique<Tumble>(); }
 std::unique_ptr<Probe> velocity_probe(const std::string& body, std::function<Vec3(double)> expected, double radius) {
-  return std::make_unique<Velocity>(body, std::move(expected), radius);
+  return std::make_unique<Velocity>(std::vector<ExpectedVelocity>{{body, std::move(expected)}}, radius);
+}
+std::unique_ptr<Probe> velocities_probe(std::vector<ExpectedVelocity> bodies) {
+  return std::make_unique<Velocity>(std::move(bodies), 0.0);
 }
 std::unique_ptr<Probe> energy_rise_probe() { return std::make_unique<EnergyRise>(); }
 

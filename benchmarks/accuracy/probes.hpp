@@ -12,6 +12,8 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <utility>
+#include <vector>
 
 namespace impetus::accuracy {
 
@@ -56,6 +58,11 @@ std::unique_ptr<Probe> tumble_probe();
 /// flat ground, reported when `radius` > 0).
 std::unique_ptr<Probe> velocity_probe(const std::string& body, std::function<Vec3(double)> expected,
                                       double radius = 0.0);
+
+/// Several bodies' velocities against their closed forms: `velocity_error` = the largest |v(end) −
+/// expected(t_end)| among them (m/s).
+using ExpectedVelocity = std::pair<std::string, std::function<Vec3(double)>>;
+std::unique_ptr<Probe> velocities_probe(std::vector<ExpectedVelocity> bodies);
 
 /// Total energy (kinetic + potential, zero at z = 0) should never increase: `energy_rise` = max over t of
 /// E(t) − min_{s ≤ t} E(s), relative to E0; `max_penetration` (m).

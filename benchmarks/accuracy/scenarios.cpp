@@ -260,6 +260,47 @@ std::vector<Scenario> scenarios(bool quick) {
     out.push_back(std::move(s));
   }
   {
+    // Isotropy: the same slope falling along the diagonal of x and y (gravity turned 45° about z), where
+    // a friction law built from two tangent directions would not give Coulomb's answer.
+    Scenario s = simulation("friction_slope_diagonal", "friction",
+                            "Box sliding down a 30° slope along the x-y diagonal, μ = 0.5, 1 s", "friction_slope.yaml",
+                            1.0, 1.0 / 1000, {1.0 / 60, 1.0 / 240, 1.0 / 1000}, quick);
+    s.overrides = {{"gravity", "[3.4683587617200149, 3.4683587617200149, -8.495709211125344]"}};
+    s.resolvers = frictional;
+    s.sweep = IntegratorSweep::reference;
+    s.measures = "the box's velocity against a = g (sin 30° − μ cos 30°) t along (1, 1, 0)/√2";
+    s.error_doc = {{"velocity_error", "|v - a t (1, 1, 0)/√2| at the end (m/s)"}};
+    s.primary = "velocity_error";
+    s.criterion = "velocity within 1e-6 m/s of the closed form";
+    s.bounds = {{"velocity_error", 1e-6}};
+    const double a = 9.81 * (0.5 - 0.5 * std::sqrt(3.0) / 2.0) / std::sqrt(2.0);  // per axis
+    s.probe = [a] { return velocity_probe("box", [a](double t) { return Vec3(a * t, a * t, 0); }); };
+    out.push_back(std::move(s));
+  }
+  {
+    // The friction ramp (after Box2D's benchmark): five boxes on one 30° slope with contact μ = 0.1, 0.3,
+    // 0.5 (slide), 0.6 and 0.8 (stick, tan 30° = 0.577).
+    Scenario s = simulation("friction_ramp", "friction", "Friction ramp: five boxes on a 30° slope, μ = 0.1 to 0.8, 1 s",
+                            "friction_ramp.yaml", 1.0, 1.0 / 1000, {1.0 / 60, 1.0 / 240, 1.0 / 1000}, quick);
+    s.resolvers = frictional;
+    s.sweep = IntegratorSweep::reference;
+    s.measures = "each box's velocity against max(0, g (sin 30° − μ cos 30°)) t down the slope";
+    s.error_doc = {{"velocity_error", "largest |v - a_mu t| over the five boxes at the end (m/s)"}};
+    s.primary = "velocity_error";
+    s.criterion = "every box within 1e-6 m/s of its closed form";
+    s.bounds = {{"velocity_error", 1e-6}};
+    s.probe = [] {
+      std::vector<ExpectedVelocity> boxes;
+      for (const auto& [name, mu] : {std::pair{"box_mu01", 0.1}, std::pair{"box_mu03", 0.3}, std::pair{"box_mu05", 0.5},
+                                     std::pair{"box_mu06", 0.6}, std::pair{"box_mu08", 0.8}}) {
+        const double a = std::max(0.0, 9.81 * (0.5 - mu * std::sqrt(3.0) / 2.0));
+        boxes.emplace_back(name, [a](double t) { return Vec3(a * t, 0, 0); });
+      }
+      return velocities_probe(std::move(boxes));
+    };
+    out.push_back(std::move(s));
+  }
+  {
     Scenario s = simulation("friction_slope_stick", "friction", "Box on a 30° slope, μ = 0.7 > tan 30°: sticks, 5 s",
                             "friction_slope.yaml", quick ? 1.0 : 5.0, 1.0 / 1000, {1.0 / 60, 1.0 / 240, 1.0 / 1000}, quick);
     s.overrides = {{"bodies.box.friction", "0.7"}, {"bodies.ground.friction", "0.7"}};
@@ -298,6 +339,19 @@ std::vector<Scenario> scenarios(bool quick) {
     s.criterion = "the plank within 1 mm of its start; penetration <= 1 mm";
     s.bounds = {{"top_drift", 1e-3}, {"max_penetration", 1e-3}};
     s.probe = [] { return resting_probe("plank", std::nullopt, 0.5); };
+    out.push_back(std::move(s));
+  }
+  {
+    Scenario s = simulation("friction_stack_10", "friction", "10 stacked boxes at rest, μ = 0.5: stand, 10 s",
+                            "friction_stack_10.yaml", quick ? 1.0 : 10.0, 1.0 / 60, resting_dts, quick);
+    s.resolvers = frictional;
+    s.sweep = IntegratorSweep::reference;
+    s.measures = "drift of the top box, penetration, kinetic energy at rest";
+    s.error_doc = kRestingDoc;
+    s.primary = "top_drift";
+    s.criterion = "top box within 1 mm of its start; penetration <= 1 mm";
+    s.bounds = {{"top_drift", 1e-3}, {"max_penetration", 1e-3}};
+    s.probe = [] { return resting_probe("box10", std::nullopt, 0.5); };
     out.push_back(std::move(s));
   }
   {

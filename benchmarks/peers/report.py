@@ -86,51 +86,43 @@ def friction_table(rows):
     return "\n".join(out)
 
 
-def friction_chart(rows, path, scene):
-    import matplotlib
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-    fig, ax = plt.subplots(figsize=(9, 6))
-    for (method, s), b in rows.items():
-        if s != scene:
-            continue
-        error = max(b.get("natural_map", float("nan")), 1e-17)
-        ax.scatter(b["cpu_time"], error)
-        ax.annotate(method, (b["cpu_time"], error), fontsize=7)
-    ax.set_xscale("log")
-    ax.set_yscale("log")
-    ax.set_xlabel("CPU time per step (engines) or solve (Impetus), ms, median")
-    ax.set_ylabel("natural-map error of the engine's impulses and velocities")
-    ax.set_title(f"bench_peers with friction, {scene}")
-    ax.axhline(1e-9, color="grey", linestyle=":", linewidth=1)
-    fig.tight_layout()
-    fig.savefig(path, dpi=120)
-
-
-def chart(rows, path, scene):
+def time_error_chart(rows, path, scene, error_of, ylabel, title):
+    """CPU time against an error, one labelled point per method on `scene` (exact zero at the floor)."""
     try:
         import matplotlib
     except ImportError:
-        sys.exit("--chart needs matplotlib (Debian: python3-matplotlib; run with /usr/bin/python3)")
+        sys.exit("a chart needs matplotlib (Debian: python3-matplotlib; run with /usr/bin/python3)")
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
     fig, ax = plt.subplots(figsize=(9, 6))
     for (method, s), b in rows.items():
         if s != scene or method.endswith("_gravity"):
             continue
-        # One error axis: a method that leaves no approach but pushes the bodies apart (Baumgarte) is not
-        # exact either, so the larger of residual and complementarity is drawn; exact zero at the floor.
-        error = max(b["residual"], 0 if math.isnan(b["complementarity"]) else b["complementarity"], 1e-17)
+        error = max(error_of(b), 1e-17)
         ax.scatter(b["cpu_time"], error)
         ax.annotate(method, (b["cpu_time"], error), fontsize=7)
     ax.set_xscale("log")
     ax.set_yscale("log")
     ax.set_xlabel("CPU time per step (engines) or solve (Impetus), ms, median")
-    ax.set_ylabel("max(residual m/s, complementarity N·m/s) after")
-    ax.set_title(f"bench_peers, {scene}")
+    ax.set_ylabel(ylabel)
+    ax.set_title(title)
     ax.axhline(1e-9, color="grey", linestyle=":", linewidth=1)
     fig.tight_layout()
     fig.savefig(path, dpi=120)
+
+
+def friction_chart(rows, path, scene):
+    time_error_chart(rows, path, scene, lambda b: b.get("natural_map", float("nan")),
+                     "natural-map error of the engine's impulses and velocities",
+                     f"bench_peers with friction, {scene}")
+
+
+def chart(rows, path, scene):
+    # One error axis: a method that leaves no approach but pushes the bodies apart (Baumgarte) is not
+    # exact either, so the larger of residual and complementarity is drawn.
+    time_error_chart(rows, path, scene,
+                     lambda b: max(b["residual"], 0 if math.isnan(b["complementarity"]) else b["complementarity"]),
+                     "max(residual m/s, complementarity N·m/s) after", f"bench_peers, {scene}")
 
 
 def main():

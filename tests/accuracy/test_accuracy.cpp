@@ -195,5 +195,15 @@ TEST(Accuracy, FrictionClosedFormsAndStatics) {
   expect_fail("friction_pyramid_10", method("mirtich"), "top_drift", 0.1);
 }
 
+// Friction's isotropy and several slopes at once: the box sliding along the x-y diagonal meets the same
+// closed form as along x, the five boxes of the friction ramp slide or stick each by its own μ, and the
+// frictional stack stands; the sequential baseline is off on the diagonal slope and the ramp.
+TEST(Accuracy, FrictionIsotropyRampAndStack) {
+  for (const char* id : {"friction_slope_diagonal", "friction_ramp", "friction_stack_10"})
+    expect_pass(id, method("ledas/complementary"));
+  expect_fail("friction_slope_diagonal", method("mirtich"), "velocity_error", 1e-4);
+  expect_fail("friction_ramp", method("mirtich"), "velocity_error", 1e-3);
+}
+
 }  // namespace
 }  // namespace impetus::accuracy
