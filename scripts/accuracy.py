@@ -126,6 +126,10 @@ PEER_NOTES = {
         "only once the box sinks into the slope), then holds it; Bullet creeps 1.5e-5 m (1/1000 s) to 4 mm "
         "(1/60 s), ODE QuickStep 0.5-9 mm, and MuJoCo's regularized friction lets the box slide on steadily "
         "(9.5-15 mm in 5 s with both solvers).",
+    "friction_kane_rod":
+        "Bullet (10 or 100 iterations) and ODE (QuickStep and dWorldStep) all leave the rod with 37 % more "
+        "kinetic energy than it came with: each targets a normal rebound velocity of −e v_n⁻ at the contact "
+        "while friction acts there too, Kane's paradox; MuJoCo has no restitution coefficient (unsupported).",
     "friction_slope_diagonal":
         "The isotropy test: ODE's box does not move at all (0.66 m/s short, with dWorldStep and QuickStep), "
         "since each of its two friction directions, along x and y, is bounded by μ N separately and the "

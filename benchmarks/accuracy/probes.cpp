@@ -110,6 +110,7 @@ class Cradle final : public Conserving {
 
 class Drop final : public Probe {
  public:
+  explicit Drop(bool horizontal) : horizontal_(horizontal) {}
   void start(const World& world) override { e0_ = measure(world).kinetic_energy; }
   Errors finish(const World& world, double) override {
     const double dt = world.settings().dt;
@@ -120,12 +121,13 @@ class Drop final : public Probe {
       residual = std::max(residual, -vn - gap / dt);
     }
     const WorldMetrics m = measure(world);
-    return {{"residual", std::max(0.0, residual)},
-            {"energy_gain", std::max(0.0, (m.kinetic_energy - e0_) / e0_)},
-            {"horizontal_momentum", m.linear_momentum.head<2>().norm()}};
+    Errors out{{"residual", std::max(0.0, residual)}, {"energy_gain", std::max(0.0, (m.kinetic_energy - e0_) / e0_)}};
+    if (horizontal_) out["horizontal_momentum"] = m.linear_momentum.head<2>().norm();
+    return out;
   }
 
  private:
+  bool horizontal_;
   double e0_ = 0.0;
 };
 
@@ -272,7 +274,8 @@ class EnergyRise final : public Probe {
 std::unique_ptr<Probe> two_balls_probe() { return std::make_unique<TwoBalls>(); }
 std::unique_ptr<Probe> billiards_probe() { return std::make_unique<Billiards>(); }
 std::unique_ptr<Probe> cradle_probe(int balls) { return std::make_unique<Cradle>(balls); }
-std::unique_ptr<Probe> drop_probe() { return std::make_unique<Drop>(); }
+std::unique_ptr<Probe> drop_probe() { return std::make_unique<Drop>(true); }
+std::unique_ptr<Probe> impact_energy_probe() { return std::make_unique<Drop>(false); }
 std::unique_ptr<Probe> min_norm_probe(const std::string& body) { return std::make_unique<MinNorm>(body); }
 std::unique_ptr<Probe> resting_probe(const std::string& top, std::optional<Vec3> rest, double window) {
   return std::make_unique<Resting>(top, rest, window);

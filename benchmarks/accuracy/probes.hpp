@@ -33,6 +33,9 @@ std::unique_ptr<Probe> cradle_probe(int balls);
 /// An inelastic drop (pyramid): `residual` = max over contacts of the approach left, max(0, −v_n −
 /// gap/dt) (m/s), `energy_gain` = max(0, (E⁺ − E⁻) / E⁻), `horizontal_momentum` = |P_xy| (kg·m/s).
 std::unique_ptr<Probe> drop_probe();
+/// An impact against fixed ground (friction may take momentum): `residual` and `energy_gain` as drop_probe,
+/// without the horizontal momentum.
+std::unique_ptr<Probe> impact_energy_probe();
 
 /// Figure 2 (figure2.yaml, body `body` landing flat on a fixed beam): `min_norm_distance` = |p − p⁺| / |p⁺|
 /// where p are the contact impulses and p⁺ = (Gᵀ)⁺ Gᵀ p the minimum-norm impulses with the same effect

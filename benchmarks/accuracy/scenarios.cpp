@@ -246,6 +246,21 @@ std::vector<Scenario> scenarios(bool quick) {
   // friction, so these run with the complementary mode and the sequential baseline.
   const std::vector<std::string> frictional{"ledas/complementary", "mirtich"};
   {
+    // Kane's rod: an oblique, spinning impact with friction and restitution, where Newton's rule applied
+    // to a frictional impulse can create energy.
+    Scenario s = impact("friction_kane_rod", "friction",
+                        "Kane's rod: spinning rod strikes the ground, μ = 0.8, e = 1", "kane_rod.yaml");
+    s.resolvers = frictional;
+    s.measures = "kinetic energy after the impact against before, approach left";
+    s.error_doc = {{"energy_gain", "max(0, (E+ - E-) / E-) of the kinetic energy"},
+                   {"residual", "largest approach velocity left at a contact (m/s)"}};
+    s.primary = "energy_gain";
+    s.criterion = "no energy gain (1e-12 relative), no approach left (1e-6 m/s)";
+    s.bounds = {{"energy_gain", 1e-12}, {"residual", 1e-6}};
+    s.probe = [] { return impact_energy_probe(); };
+    out.push_back(std::move(s));
+  }
+  {
     Scenario s = simulation("friction_slope_slide", "friction", "Box sliding down a 30° slope, μ = 0.5, 1 s",
                             "friction_slope.yaml", 1.0, 1.0 / 1000, {1.0 / 60, 1.0 / 240, 1.0 / 1000}, quick);
     s.resolvers = frictional;
