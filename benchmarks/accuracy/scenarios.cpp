@@ -261,6 +261,21 @@ std::vector<Scenario> scenarios(bool quick) {
     out.push_back(std::move(s));
   }
   {
+    // Painlevé's rod: sliding with μ = 1.5 at 63°, where Coulomb's law with forces has no solution.
+    Scenario s = simulation("friction_painleve_rod", "friction", "Painlevé's rod: sliding at 63°, μ = 1.5, 0.2 s",
+                            "painleve_rod.yaml", 0.2, 1.0 / 1000, {1.0 / 60, 1.0 / 240, 1.0 / 1000}, quick);
+    s.resolvers = frictional;
+    s.sweep = IntegratorSweep::reference;
+    s.measures = "rise of the total energy (kinetic + potential) at any time";
+    s.error_doc = {{"energy_rise", "max over t of E(t) - min over s <= t of E(s), relative to E0"},
+                   {"max_penetration", "largest contact depth over the run (m)"}};
+    s.primary = "energy_rise";
+    s.criterion = "total energy never rises by more than 1e-6 E0; penetration <= 1 mm";
+    s.bounds = {{"energy_rise", 1e-6}, {"max_penetration", 1e-3}};
+    s.probe = [] { return energy_rise_probe(); };
+    out.push_back(std::move(s));
+  }
+  {
     Scenario s = simulation("friction_slope_slide", "friction", "Box sliding down a 30° slope, μ = 0.5, 1 s",
                             "friction_slope.yaml", 1.0, 1.0 / 1000, {1.0 / 60, 1.0 / 240, 1.0 / 1000}, quick);
     s.resolvers = frictional;

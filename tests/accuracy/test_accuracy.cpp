@@ -213,5 +213,12 @@ TEST(Accuracy, KanesRodGainsNoEnergy) {
   expect_pass("friction_kane_rod", method("mirtich"));
 }
 
+// Painlevé's rod (μ = 1.5 at 63°, where Coulomb's law with forces has no solution): at the impulse level
+// the rod jams and falls, and neither resolver lets the total energy rise (1e-6 E0).
+TEST(Accuracy, PainlevesRodJamsWithoutGainingEnergy) {
+  expect_pass("friction_painleve_rod", method("ledas/complementary"));
+  expect_pass("friction_painleve_rod", method("mirtich"));
+}
+
 }  // namespace
 }  // namespace impetus::accuracy
