@@ -133,7 +133,7 @@ PEER_NOTES = {
     "friction_painleve_rod":
         "At the reference step (1/1000 s) only Bullet SI 100 keeps the total energy from rising: Bullet SI 10 "
         "and MuJoCo gain 1.7-1.8e-5 of it (nothing at the coarser steps), and ODE gains at every step size "
-        "(5-6e-6 at 1/1000 s, 4-5e-4 at 1/60 s). No engine blows up: the cases Coulomb's law with forces "
+        "(4.6-5.9e-6 at 1/1000 s, 3.8-5.2e-4 at 1/60 s). No engine blows up: the cases Coulomb's law with forces "
         "cannot answer are answered at the velocity level by every engine.",
     "friction_slope_diagonal":
         "The isotropy test: ODE's box does not move at all (0.66 m/s short, with dWorldStep and QuickStep), "
