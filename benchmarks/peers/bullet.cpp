@@ -7,8 +7,8 @@
 // √μ, so that Bullet's product is the scene's μ; Bullet's friction rows as shipped (one per contact point,
 // along its slip) or with SOLVER_USE_2_FRICTION_DIRECTIONS (the `_2dir` rows: two, each clamped to ±μ p_n,
 // a box around the cone). The impulse a point applied to body A is p n_B + l1 d1 + l2 d2
-// (btManifoldPoint's applied impulses along its normal and its two lateral directions). Every reset clears the contact manifolds,
-// so no step is warm-started from the previous one.
+// (btManifoldPoint's applied impulses along its normal and its two lateral directions). Every reset
+// clears the contact manifolds, so no step is warm-started from the previous one.
 #include "peers.hpp"
 
 #include <btBulletDynamicsCommon.h>

@@ -70,7 +70,8 @@ class ImpetusWholeStep final : public PeerStep {
       r.angular_velocity.push_back(b.angular_velocity);
     }
     ContactTally tally(pairs_, scene_.contacts, true);
-    for (const Contact& c : world_.contacts()) tally.add(c.a, c.b, c.impulse, c.impulse * c.normal + c.tangent_impulse);
+    for (const Contact& c : world_.contacts())
+      tally.add(c.a, c.b, c.impulse, c.impulse * c.normal + c.tangent_impulse);  // the whole impulse, on b
     tally.finish(r);
     r.iterations = static_cast<double>(last_.resolver.rounds);
     r.failures = static_cast<double>(last_.resolver.non_converged);

@@ -18,10 +18,11 @@
 //   solver_ms               the engine's solver alone, mean per step (NaN where it cannot be separated)
 // With friction (scenes "…_muX", every body's μ = X):
 //   natural_map             fclib's natural-map error, unscaled: the 2-norm over contacts of
-//                           r − P_K(r − (u_n + μ‖u_t‖, u_t)), r the engine's own impulse on the contact (normal
-//                           and friction) and u the relative velocity its step left, in the contact's frame
-//   impulse_mismatch        max over bodies of |m (v⁺ − v⁻ − g dt) − Σ impulses| (N·s): whether the impulses
-//                           the engine reports are the ones it applied
+//                           r − P_K(r − (u_n + μ‖u_t‖, u_t)), r the engine's own impulse on the contact
+//                           (normal and friction) and u the relative velocity its step left, in the
+//                           contact's frame
+//   impulse_mismatch        max over bodies of |m (v⁺ − v⁻ − g dt) − Σ impulses| (N·s): whether the
+//                           impulses the engine reports are the ones it applied
 //   exact                   natural_map ≤ 1e-9 and residual ≤ 1e-9 (as bench_resolve)
 #include "peers.hpp"
 

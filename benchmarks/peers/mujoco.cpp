@@ -1,7 +1,8 @@
 // MuJoCo on the peers' scenes: a model built from an MJCF string (loaded through a virtual file system):
 // one free body per sphere (geom sphere, mass 1, so inertia 2/5 m r² as Impetus), the fixed plane as a
 // world geom, every geom condim = 1 (frictionless; with friction, the "_mu" scenes: condim 3, friction
-// "μ 0 0" — sliding only — and elliptic cones, or pyramidal ones in the `_pyramidal` rows), Euler integrator, dt, gravity as set; solver PGS, CG or
+// "μ 0 0" — sliding only — and elliptic cones, or pyramidal ones in the `_pyramidal` rows), Euler
+// integrator, dt, gravity as set; solver PGS, CG or
 // Newton with iterations 100 and tolerance 1e-10. One mj_step from mj_resetData (no warm start).
 //
 // MuJoCo's contacts are soft (DESIGN of MuJoCo, "solver parameters"): the solve gives J a = d·a_ref with

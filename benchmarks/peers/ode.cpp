@@ -7,7 +7,8 @@
 // Friction (the "_mu" scenes): mu = the scene's μ with dContactApprox1, so that each of ODE's two friction
 // directions is bounded by μ times the contact's normal force (a pyramid around the cone); without
 // dContactApprox1 ODE's mu is a force bound in newtons, not a coefficient. The impulse on body 1 is its
-// dJointFeedback force f1 times dt. ODE's LCP errors ("LCP internal error, s <= 0") arrive through dMessage: a handler
+// dJointFeedback force f1 times dt. ODE's LCP errors ("LCP internal error, s <= 0") arrive through
+// dMessage: a handler
 // counts them as failures.
 #include "ode_support.hpp"
 #include "peers.hpp"

@@ -121,7 +121,9 @@ class ContactTally {
   /// With the whole impulse `on_j` the engine applied to body j at this point.
   void add(std::size_t i, std::size_t j, double impulse, const Vec3& on_j) {
     const long k = add_point(i, j, impulse);
-    if (k >= 0) vectors_[static_cast<std::size_t>(k)] += contacts_[static_cast<std::size_t>(k)].b == j ? on_j : Vec3(-on_j);
+    if (k < 0) return;
+    const auto index = static_cast<std::size_t>(k);
+    vectors_[index] += contacts_[index].b == j ? on_j : Vec3(-on_j);
   }
 
   /// Writes the counts and impulses into `out`.

@@ -198,7 +198,8 @@ void add_bullet_methods(std::vector<PeerMethod>& out) {
     m.integrator = "Bullet (semi-implicit Euler)";
     m.description = "btSequentialImpulseConstraintSolver, " + std::to_string(iterations) +
                     " iterations" + (iterations == 10 ? " (Bullet's default)" : "") +
-                    "; friction as shipped (one row per point, along the slip); impacts: contact ERP 0, split impulse off; simulations: ERP 0.2 and split impulse as shipped";
+                    "; friction as shipped (one row per point, along the slip); impacts: contact ERP 0, split "
+                    "impulse off; simulations: ERP 0.2 and split impulse as shipped";
     m.unsupported = bullet_unsupported;
     m.make = [iterations](const PeerScene& scene) { return std::make_unique<BulletWorld>(scene, iterations); };
     out.push_back(std::move(m));

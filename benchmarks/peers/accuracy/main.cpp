@@ -117,7 +117,8 @@ RunResult run(const Scenario& scenario, const PeerMethod& method, double dt, con
                                                                  : nullptr;
     if (missing) {
       result.status = "unsupported";
-      result.message = method.label() + ": body '" + b.name + "' has " + missing + ", which is not translated to the peers yet";
+      result.message =
+          method.label() + ": body '" + b.name + "' has " + missing + ", which is not translated to the peers yet";
       return result;
     }
   }

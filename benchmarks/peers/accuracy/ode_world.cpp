@@ -223,8 +223,8 @@ void add_ode_methods(std::vector<PeerMethod>& out) {
   PeerMethod exact = quick;
   exact.setting = "worldstep";
   exact.description = "dWorldStep (Dantzig LCP), CFM 1e-10; ERP 1e-6 on impacts (the light regularization without "
-                      "which the LCP gives up silently on zero-velocity contacts), 0.2 (shipped) in simulations; friction: mu = "
-                      "√(μ_a μ_b) with dContactApprox1 (a pyramid scaled by the normal force)";
+                      "which the LCP gives up silently on zero-velocity contacts), 0.2 (shipped) in simulations; "
+                      "friction: mu = √(μ_a μ_b) with dContactApprox1 (a pyramid scaled by the normal force)";
   exact.make = [](const PeerScene& scene) { return std::make_unique<OdeWorld>(scene, OdeConfig{false, 20}); };
   out.push_back(exact);
 }
