@@ -13,6 +13,7 @@
 // counters add natural_map (ledas's natural-map residual), sticking and sliding. The walls of 200 and
 // 1,000 bricks (25 per course) run only with IMPETUS_BENCH_SLOW=1: one step of the 200-brick wall takes
 // ledas 10-140 s today (benchmarks/README.md), so the default suite would not finish.
+#include "support/allocation_counter.hpp"
 #include "support/bench_dynamic.hpp"
 #include "support/bench_main.hpp"
 #include "support/bench_resolvers.hpp"
@@ -101,7 +102,7 @@ void step(benchmark::State& state, const std::string& resolver_name, Scene scene
   world.set_detector(std::make_shared<FclDetector>(detector));
   world.set_resolver(bench::make_resolver(resolver_name, /*velocity_only=*/false));
 
-  const auto [sum, last, cold_ms] = bench::time_steps(state, world, initial);
+  const auto [sum, last, cold_ms, allocations] = bench::time_steps(state, world, initial, &bench::allocations);
   const auto per_step = benchmark::Counter::kAvgIterations;
   state.counters["bodies"] = static_cast<double>(initial.size() - 1);
   state.counters["contacts"] = static_cast<double>(last.detector.contacts);
@@ -113,6 +114,7 @@ void step(benchmark::State& state, const std::string& resolver_name, Scene scene
   state.counters["resolve_ms"] = benchmark::Counter(1e3 * sum.resolve, per_step);
   state.counters["positions_ms"] = benchmark::Counter(1e3 * sum.positions, per_step);
   state.counters["cold_ms"] = cold_ms;
+  state.counters["allocations"] = allocations;  // operator new calls per steady-state step
   state.counters["resolve_share"] = sum.total > 0 ? sum.resolve / sum.total : 0.0;
   if (scene == Scene::resting_pyramid || scene == Scene::stack || scene == Scene::wall) {
     // Only ledas reports it (mirtich's sequential impulses have no problem-wide residual: 0 would mislead).
