@@ -45,6 +45,10 @@ const std::map<std::string, std::string> kRestingDoc{
     {"top_drift", "distance of the top body from its rest position at the end (m)"},
     {"rest_kinetic_energy", "largest total kinetic energy over the last window (J): jitter"}};
 
+const std::map<std::string, std::string> kEnergyRiseDoc{
+    {"energy_rise", "max over t of E(t) - min over s <= t of E(s), relative to E0"},
+    {"max_penetration", "largest contact depth over the run (m)"}};
+
 }  // namespace
 
 bool Scenario::passes(const Errors& errors) const {
@@ -59,6 +63,7 @@ std::vector<Scenario> scenarios(bool quick) {
   std::vector<Scenario> out;
   const std::vector<double> resting_dts{1.0 / 30, 1.0 / 60, 1.0 / 120, 1.0 / 240};
   const std::vector<double> fine_dts{1.0 / 30, 1.0 / 60, 1.0 / 100, 1.0 / 250, 1.0 / 500, 1.0 / 1000};
+  const std::vector<double> slope_dts{1.0 / 60, 1.0 / 240, 1.0 / 1000};  // the friction closed forms
 
   // 1. Two balls head on: the 1D formulas.
   for (const char* e : {"0", "0.5", "1"}) {
@@ -263,12 +268,11 @@ std::vector<Scenario> scenarios(bool quick) {
   {
     // Painlevé's rod: sliding with μ = 1.5 at 63°, where Coulomb's law with forces has no solution.
     Scenario s = simulation("friction_painleve_rod", "friction", "Painlevé's rod: sliding at 63°, μ = 1.5, 0.2 s",
-                            "painleve_rod.yaml", 0.2, 1.0 / 1000, {1.0 / 60, 1.0 / 240, 1.0 / 1000}, quick);
+                            "painleve_rod.yaml", 0.2, 1.0 / 1000, slope_dts, quick);
     s.resolvers = frictional;
     s.sweep = IntegratorSweep::reference;
     s.measures = "rise of the total energy (kinetic + potential) at any time";
-    s.error_doc = {{"energy_rise", "max over t of E(t) - min over s <= t of E(s), relative to E0"},
-                   {"max_penetration", "largest contact depth over the run (m)"}};
+    s.error_doc = kEnergyRiseDoc;
     s.primary = "energy_rise";
     s.criterion = "total energy never rises by more than 1e-6 E0; penetration <= 1 mm";
     s.bounds = {{"energy_rise", 1e-6}, {"max_penetration", 1e-3}};
@@ -277,7 +281,7 @@ std::vector<Scenario> scenarios(bool quick) {
   }
   {
     Scenario s = simulation("friction_slope_slide", "friction", "Box sliding down a 30° slope, μ = 0.5, 1 s",
-                            "friction_slope.yaml", 1.0, 1.0 / 1000, {1.0 / 60, 1.0 / 240, 1.0 / 1000}, quick);
+                            "friction_slope.yaml", 1.0, 1.0 / 1000, slope_dts, quick);
     s.resolvers = frictional;
     s.sweep = IntegratorSweep::reference;
     s.measures = "the box's velocity against a = g (sin 30° − μ cos 30°) t";
@@ -294,7 +298,7 @@ std::vector<Scenario> scenarios(bool quick) {
     // a friction law built from two tangent directions would not give Coulomb's answer.
     Scenario s = simulation("friction_slope_diagonal", "friction",
                             "Box sliding down a 30° slope along the x-y diagonal, μ = 0.5, 1 s", "friction_slope.yaml",
-                            1.0, 1.0 / 1000, {1.0 / 60, 1.0 / 240, 1.0 / 1000}, quick);
+                            1.0, 1.0 / 1000, slope_dts, quick);
     s.overrides = {{"gravity", "[3.4683587617200149, 3.4683587617200149, -8.495709211125344]"}};
     s.resolvers = frictional;
     s.sweep = IntegratorSweep::reference;
@@ -311,7 +315,7 @@ std::vector<Scenario> scenarios(bool quick) {
     // The friction ramp (after Box2D's benchmark): five boxes on one 30° slope with contact μ = 0.1, 0.3,
     // 0.5 (slide), 0.6 and 0.8 (stick, tan 30° = 0.577).
     Scenario s = simulation("friction_ramp", "friction", "Friction ramp: five boxes on a 30° slope, μ = 0.1 to 0.8, 1 s",
-                            "friction_ramp.yaml", 1.0, 1.0 / 1000, {1.0 / 60, 1.0 / 240, 1.0 / 1000}, quick);
+                            "friction_ramp.yaml", 1.0, 1.0 / 1000, slope_dts, quick);
     s.resolvers = frictional;
     s.sweep = IntegratorSweep::reference;
     s.measures = "each box's velocity against max(0, g (sin 30° − μ cos 30°)) t down the slope";
@@ -332,7 +336,7 @@ std::vector<Scenario> scenarios(bool quick) {
   }
   {
     Scenario s = simulation("friction_slope_stick", "friction", "Box on a 30° slope, μ = 0.7 > tan 30°: sticks, 5 s",
-                            "friction_slope.yaml", quick ? 1.0 : 5.0, 1.0 / 1000, {1.0 / 60, 1.0 / 240, 1.0 / 1000}, quick);
+                            "friction_slope.yaml", quick ? 1.0 : 5.0, 1.0 / 1000, slope_dts, quick);
     s.overrides = {{"bodies.box.friction", "0.7"}, {"bodies.ground.friction", "0.7"}};
     s.resolvers = frictional;
     s.sweep = IntegratorSweep::reference;
@@ -346,7 +350,7 @@ std::vector<Scenario> scenarios(bool quick) {
   }
   {
     Scenario s = simulation("friction_sphere_roll", "friction", "Sphere thrown sliding at 2 m/s, μ = 0.2: rolls at 5/7 v0, 1 s",
-                            "friction_sphere.yaml", 1.0, 1.0 / 1000, {1.0 / 60, 1.0 / 240, 1.0 / 1000}, quick);
+                            "friction_sphere.yaml", 1.0, 1.0 / 1000, slope_dts, quick);
     s.resolvers = frictional;
     s.sweep = IntegratorSweep::reference;
     s.measures = "final velocity against 5/7 v0, and the slip of the contact point";
@@ -406,8 +410,7 @@ std::vector<Scenario> scenarios(bool quick) {
                             "accuracy_bracket_bounce.yaml", duration, 1.0 / 1000, fine_dts, quick);
     s.sweep = IntegratorSweep::every_dt;
     s.measures = "rise of the total energy (kinetic + potential) at any time";
-    s.error_doc = {{"energy_rise", "max over t of E(t) - min over s <= t of E(s), relative to E0"},
-                   {"max_penetration", "largest contact depth over the run (m)"}};
+    s.error_doc = kEnergyRiseDoc;
     s.primary = "energy_rise";
     s.criterion = "total energy never rises by more than 1e-3 E0";
     s.bounds = {{"energy_rise", 1e-3}};
