@@ -232,5 +232,48 @@ TEST(HostileInputRound2Counts, AddBodiesChecksNamesAndAddsAllOrNothing) {
             std::string::npos);
 }
 
+// A scene's bodies, written and generated, are bounded together (SceneLimits::bodies): each generator is
+// bounded alone, but a few lines of generators could otherwise ask for any number of them. The one that
+// crosses the limit is refused at its line before it makes a body.
+TEST(HostileInputRound2Counts, SceneBodiesAreBoundedTogether) {
+  const std::string lines =
+      "generators:\n"
+      "  - line: {count: 6, radius: 0.1}\n"
+      "  - pyramid: {rows: 3, radius: 0.1, ground: false}\n";
+  const SceneLimits ten{.bodies = 10};
+  // 6 spheres and a wall, then 6 more: 13 > 10, refused at the pyramid's rows.
+  const std::string error =
+      error_of([&] { load_scene_text(lines, "scene.yaml", scenes_dir(), {}, ten); });
+  EXPECT_NE(error.find("scene.yaml:3:21: this pyramid makes 6 bodies, and with the 7 before it the scene would hold "
+                       "more than 10 bodies (the limit)"),
+            std::string::npos)
+      << error;
+  // Exactly at the limit loads.
+  EXPECT_EQ(load_scene_text(lines, "scene.yaml", scenes_dir(), {{"generators.1.pyramid.rows", "2"}}, ten).bodies.size(),
+            10u);
+  // Written bodies count too, at the entry past the limit.
+  std::string written = "bodies:\n";
+  for (int i = 0; i < 3; ++i)
+    written += "  - {name: b" + std::to_string(i) + ", shape: {sphere: {radius: 0.5}}, mass: 1, position: [" +
+               std::to_string(2 * i) + ", 0, 0]}\n";
+  EXPECT_NE(error_of([&] { load_scene_text(written, "scene.yaml", scenes_dir(), {}, SceneLimits{.bodies = 2}); })
+                .find("scene.yaml:4:5: the scene holds more than 2 bodies (the limit)"),
+            std::string::npos);
+  // A generator's own range is still reported as such, not as the scene's limit.
+  EXPECT_NE(load_text("generators:\n  - pyramid: {rows: 5000}\n").find("pyramid 'rows' must be between 1 and 1000"),
+            std::string::npos);
+  // The default limit, 2^20 = 1,048,576: the largest pyramid (500,501 bodies with the ground) and a line
+  // of 548,076 spheres cross it by one, and the line is refused before it is made.
+  const std::string pyramid_and_line =
+      "generators:\n"
+      "  - pyramid: {rows: 1000, radius: 0.1}\n"
+      "  - line: {count: 548076, radius: 0.1, wall: false}\n";
+  const std::string two_error = load_text(pyramid_and_line);
+  EXPECT_NE(two_error.find("scene.yaml:3:19: this line makes 548076 bodies, and with the 500501 "
+                           "before it the scene would hold more than 1048576 bodies (the limit)"),
+            std::string::npos)
+      << two_error;
+}
+
 }  // namespace
 }  // namespace impetus::reliability

@@ -44,7 +44,7 @@ void add_bodies(const SceneReader& r, std::vector<ReadBody> read, bool generated
   }
 }
 
-Scene read_scene(const SceneReader& r, const YAML::Node& root) {
+Scene read_scene(const SceneReader& r, const YAML::Node& root, const SceneLimits& limits) {
   if (!root.IsMap()) r.fail(root, "a scene is a mapping of keys (dt, gravity, modules, bodies, ...), got " +
                                       SceneReader::describe(root));
   const Fields f(r, root, "scene",
@@ -92,12 +92,17 @@ Scene read_scene(const SceneReader& r, const YAML::Node& root) {
   std::map<std::string, std::string> where_by_name;
   if (const YAML::Node* n = f.find("bodies")) {
     const std::vector<YAML::Node> list = r.list(*n, "bodies");
-    for (std::size_t i = 0; i < list.size(); ++i)
+    for (std::size_t i = 0; i < list.size(); ++i) {
+      if (scene.bodies.size() >= limits.bodies)
+        r.fail(list[i], "the scene holds more than " + std::to_string(limits.bodies) + " bodies (the limit)");
       add_bodies(r, {scene_detail::read_body(r, list[i], i)}, false, scene, index_by_name, where_by_name);
+    }
   }
   if (const YAML::Node* n = f.find("generators"))
-    for (const YAML::Node& entry : r.list(*n, "generators"))
-      add_bodies(r, scene_detail::read_generator(r, entry), true, scene, index_by_name, where_by_name);
+    for (const YAML::Node& entry : r.list(*n, "generators")) {
+      const scene_detail::BodyRoom room{scene.bodies.size(), limits.bodies};
+      add_bodies(r, scene_detail::read_generator(r, entry, room), true, scene, index_by_name, where_by_name);
+    }
   // Constraints last: they name bodies, including generated ones, and use their initial poses.
   if (const YAML::Node* n = f.find("constraints"))
     for (const YAML::Node& entry : r.list(*n, "constraints")) {
@@ -136,12 +141,12 @@ PluginRequest plugin_request(const ModuleRequest& module, ModuleKind kind, const
 }  // namespace
 
 Scene load_scene_text(const std::string& yaml, const std::string& name, const std::filesystem::path& base_dir,
-                      const std::vector<SceneOverride>& overrides) {
+                      const std::vector<SceneOverride>& overrides, const SceneLimits& limits) {
   SceneReader reader(name, base_dir);
   try {
     YAML::Node root = scene_detail::load_bounded_yaml(yaml, name);
     scene_detail::apply_overrides(root, overrides, reader);
-    Scene scene = read_scene(reader, root);
+    Scene scene = read_scene(reader, root, limits);
     scene.warnings = reader.warnings();
     return scene;
   } catch (const YAML::Exception& e) {
@@ -150,7 +155,8 @@ Scene load_scene_text(const std::string& yaml, const std::string& name, const st
   }
 }
 
-Scene load_scene(const std::filesystem::path& file, const std::vector<SceneOverride>& overrides) {
+Scene load_scene(const std::filesystem::path& file, const std::vector<SceneOverride>& overrides,
+                 const SceneLimits& limits) {
   // A directory opens as a stream on Linux and reads as nothing, a device (/dev/zero) reads without end
   // and a FIFO blocks until someone writes: only a regular file (or a link to one) is read.
   std::error_code ec;
@@ -170,7 +176,7 @@ Scene load_scene(const std::filesystem::path& file, const std::vector<SceneOverr
   text << in.rdbuf();
   if (in.bad()) throw Error(file.string() + ": cannot read the scene file");
   if (text.str().empty()) throw Error(file.string() + ": the scene file is empty");
-  Scene scene = load_scene_text(text.str(), file.string(), file.parent_path(), overrides);
+  Scene scene = load_scene_text(text.str(), file.string(), file.parent_path(), overrides, limits);
   scene.file = file;
   return scene;
 }

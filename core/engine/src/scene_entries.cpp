@@ -4,6 +4,7 @@
 #include "impetus/engine/generators.hpp"
 #include "scene_internal.hpp"
 
+#include <algorithm>
 #include <climits>
 #include <cmath>
 
@@ -33,9 +34,17 @@ void read_spheres(const SceneReader& r, const Fields& f, Params& p) {
   if (const YAML::Node* n = f.find("overlap")) p.overlap = r.number(*n, "overlap");
 }
 
+// Refuses a generator of `count` bodies that would take the scene past its limit (SceneLimits).
+void check_room(const SceneReader& r, const YAML::Node& node, BodyRoom room, const char* kind, std::size_t count) {
+  if (count > room.limit - std::min(room.used, room.limit))
+    r.fail(node, "this " + std::string(kind) + " makes " + std::to_string(count) + " bodies, and with the " +
+                     std::to_string(room.used) + " before it the scene would hold more than " +
+                     std::to_string(room.limit) + " bodies (the limit)");
+}
+
 }  // namespace
 
-std::vector<ReadBody> read_generator(const SceneReader& r, const YAML::Node& node) {
+std::vector<ReadBody> read_generator(const SceneReader& r, const YAML::Node& node, BodyRoom room) {
   const Fields entry(r, node, "generator", {"pyramid", "line"});
   const Fields::Entry& kind = only_entry(r, entry, "pyramid, line");
   std::vector<RigidBody> bodies;
@@ -48,6 +57,7 @@ std::vector<ReadBody> read_generator(const SceneReader& r, const YAML::Node& nod
     read_spheres(r, f, p);
     if (const YAML::Node* n = f.find("ground")) p.ground = r.boolean(*n, "ground");
     try {
+      check_room(r, *f.find("rows"), room, "pyramid", body_count(p));
       bodies = make_pyramid(p);
     } catch (const GeneratorError& e) {
       r.fail(f.find(e.field()) ? *f.find(e.field()) : kind.value, e.what());
@@ -60,6 +70,7 @@ std::vector<ReadBody> read_generator(const SceneReader& r, const YAML::Node& nod
     read_spheres(r, f, p);
     if (const YAML::Node* n = f.find("wall")) p.wall = r.boolean(*n, "wall");
     try {
+      check_room(r, *f.find("count"), room, "line", body_count(p));
       bodies = make_line(p);
     } catch (const GeneratorError& e) {
       r.fail(f.find(e.field()) ? *f.find(e.field()) : kind.value, e.what());

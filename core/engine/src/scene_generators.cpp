@@ -67,16 +67,28 @@ RigidBody plane_body(std::string name, const Vec3& normal, double offset, double
 
 }  // namespace
 
-std::vector<RigidBody> make_pyramid(const PyramidParams& p) {
+std::size_t body_count(const PyramidParams& p) {
   if (p.rows < 1 || p.rows > kMaxRows)
     throw GeneratorError("rows", "pyramid 'rows' must be between 1 and " + std::to_string(kMaxRows) + ", got " +
                                      std::to_string(p.rows));
+  return static_cast<std::size_t>(p.rows) * (p.rows + 1) / 2 + (p.ground ? 1 : 0);
+}
+
+std::size_t body_count(const LineParams& p) {
+  if (p.count < 1 || p.count > kMaxCount)
+    throw GeneratorError("count", "line 'count' must be between 1 and " + std::to_string(kMaxCount) + ", got " +
+                                      std::to_string(p.count));
+  return static_cast<std::size_t>(p.count) + (p.wall ? 1 : 0);
+}
+
+std::vector<RigidBody> make_pyramid(const PyramidParams& p) {
+  const std::size_t count = body_count(p);
   check_common("pyramid", p.radius, p.mass, p.velocity, p.restitution, p.friction, p.overlap);
   const double r = p.radius;
   const double spacing = 2.0 * r * (1.0 - p.overlap);  // neighbours overlap by 2r·overlap
   const double rise = std::sqrt(3.0) / 2.0 * spacing;  // row height: equilateral triangles of side `spacing`
   std::vector<RigidBody> bodies;
-  bodies.reserve(static_cast<std::size_t>(p.rows) * (p.rows + 1) / 2 + 1);
+  bodies.reserve(count);
   for (int row = 0; row < p.rows; ++row) {
     for (int i = 0; i < p.rows - row; ++i) {
       const Vec3 position((0.5 * row + i) * spacing, 0.0, r * (1.0 - p.overlap) + row * rise);
@@ -90,14 +102,12 @@ std::vector<RigidBody> make_pyramid(const PyramidParams& p) {
 }
 
 std::vector<RigidBody> make_line(const LineParams& p) {
-  if (p.count < 1 || p.count > kMaxCount)
-    throw GeneratorError("count", "line 'count' must be between 1 and " + std::to_string(kMaxCount) + ", got " +
-                                      std::to_string(p.count));
+  const std::size_t count = body_count(p);
   check_common("line", p.radius, p.mass, p.velocity, p.restitution, p.friction, p.overlap);
   const double r = p.radius;
   const double spacing = 2.0 * r * (1.0 - p.overlap);
   std::vector<RigidBody> bodies;
-  bodies.reserve(static_cast<std::size_t>(p.count) + 1);
+  bodies.reserve(count);
   for (int i = 0; i < p.count; ++i)
     bodies.push_back(sphere_body("line_" + std::to_string(i), r, p.mass, Vec3(i * spacing, 0.0, 0.0), p.restitution,
                                    p.friction));

@@ -21,8 +21,15 @@ struct ReadBody {
 /// Reads one entry of `bodies:` (the `index`-th, for messages before its name is known).
 ReadBody read_body(const SceneReader& reader, const YAML::Node& node, std::size_t index);
 
-/// Reads one entry of `generators:` and returns the bodies it makes.
-std::vector<ReadBody> read_generator(const SceneReader& reader, const YAML::Node& node);
+/// The bodies a scene already holds and the most it may hold (SceneLimits::bodies).
+struct BodyRoom {
+  std::size_t used = 0;
+  std::size_t limit = 0;
+};
+
+/// Reads one entry of `generators:` and returns the bodies it makes; refuses, before making them, a
+/// generator whose bodies (a ground or wall included) would not fit in `room`.
+std::vector<ReadBody> read_generator(const SceneReader& reader, const YAML::Node& node, BodyRoom room);
 
 /// Reads `modules.<kind>`; `node` is null when the scene omits it (the default plugin is used).
 ModuleRequest read_module(const SceneReader& reader, const YAML::Node* node, ModuleKind kind);

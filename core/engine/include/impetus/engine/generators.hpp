@@ -7,6 +7,7 @@
 #include "impetus/core/body.hpp"
 #include "impetus/core/error.hpp"
 
+#include <cstddef>
 #include <string>
 #include <utility>
 #include <vector>
@@ -57,6 +58,12 @@ class GeneratorError : public Error {
  private:
   std::string field_;
 };
+
+/// How many bodies make_pyramid / make_line return (the ground or wall included), computed without
+/// making them, so that a loader can refuse a scene too large first. Throws GeneratorError if `rows`
+/// or `count` is out of range.
+std::size_t body_count(const PyramidParams& params);
+std::size_t body_count(const LineParams& params);
 
 /// The pyramid's bodies: spheres row by row from the bottom, left to right, named "pyramid_r{row}_{i}",
 /// then (if `ground`) the fixed plane "ground". Throws GeneratorError for a parameter out of range.

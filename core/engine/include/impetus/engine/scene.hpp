@@ -7,6 +7,7 @@
 #include "impetus/engine/world.hpp"
 #include "impetus/modules/options.hpp"
 
+#include <cstddef>
 #include <filesystem>
 #include <memory>
 #include <string>
@@ -50,14 +51,25 @@ struct Scene {
   std::vector<std::string> warnings;
 };
 
+/// Bounds on what one scene may make, so that a few lines of text cannot ask for unbounded memory
+/// (README, "Hostile input, second sweep"). A scene past one is refused at the body or generator
+/// that crosses it, before that generator makes anything.
+struct SceneLimits {
+  /// Bodies written and generated, together: 2^20, room for the largest generated line (10^6
+  /// spheres and its wall). Each generator alone is also bounded (a line by 10^6 spheres, a pyramid by
+  /// 1,000 rows), but several of them are not. A body takes about 1 KB once in a World.
+  std::size_t bodies = std::size_t{1} << 20;
+};
+
 /// Loads and validates a scene file, applying `overrides` first. Throws Error with file, line, column
 /// and reason.
-Scene load_scene(const std::filesystem::path& file, const std::vector<SceneOverride>& overrides = {});
+Scene load_scene(const std::filesystem::path& file, const std::vector<SceneOverride>& overrides = {},
+                 const SceneLimits& limits = {});
 
 /// Same from YAML text; `name` is used in messages and relative paths resolve against `base_dir`.
 Scene load_scene_text(const std::string& yaml, const std::string& name,
                       const std::filesystem::path& base_dir,
-                      const std::vector<SceneOverride>& overrides = {});
+                      const std::vector<SceneOverride>& overrides = {}, const SceneLimits& limits = {});
 
 /// Parses "KEY=VALUE". Throws Error if there is no '=' or the key is empty.
 SceneOverride parse_override(const std::string& text);
