@@ -75,12 +75,12 @@ void apply_row_impulse(const ImpulseRow& row, double p, std::span<RigidBody> bod
   apply_normal_impulse(bodies[row.b], p, row.normal, row.turn_b);
 }
 
-std::vector<std::vector<std::uint32_t>> find_islands(std::span<const ImpulseRow> rows,
-                                                     std::size_t body_count,
-                                                     std::span<const RigidBody> bodies) {
+void find_islands(std::span<const ImpulseRow> rows, std::size_t body_count, std::span<const RigidBody> bodies,
+                  IslandSet& out) {
   // Union-find over bodies; a row joins its two bodies unless one is fixed (fixed bodies never carry
   // an impulse from one row to another).
-  std::vector<std::uint32_t> parent(body_count);
+  std::vector<std::uint32_t>& parent = out.parent_;
+  parent.resize(body_count);
   std::iota(parent.begin(), parent.end(), 0u);
   const auto find = [&](std::uint32_t x) {
     while (parent[x] != x) x = parent[x] = parent[parent[x]];
@@ -91,20 +91,45 @@ std::vector<std::vector<std::uint32_t>> find_islands(std::span<const ImpulseRow>
     const std::uint32_t ra = find(r.a), rb = find(r.b);
     if (ra != rb) parent[std::max(ra, rb)] = std::min(ra, rb);
   }
-  // A row belongs to the island of its movable body.
-  std::vector<std::int64_t> island_of_root(body_count, -1);
-  std::vector<std::vector<std::uint32_t>> islands;
+  // A row belongs to the island of its movable body; islands are numbered by their first row. Count
+  // each island's rows, then lay them out in row order.
+  out.island_of_root_.assign(body_count, -1);
+  out.island_of_row_.assign(rows.size(), -1);
+  out.start_.assign(1, 0);
   for (std::uint32_t k = 0; k < rows.size(); ++k) {
     const ImpulseRow& r = rows[k];
     const BodyIndex body = bodies[r.a].fixed ? r.b : r.a;
     if (bodies[body].fixed) continue;  // fixed–fixed: nothing to resolve
-    const std::uint32_t root = find(body);
-    if (island_of_root[root] < 0) {
-      island_of_root[root] = static_cast<std::int64_t>(islands.size());
-      islands.emplace_back();
+    std::int64_t& island = out.island_of_root_[find(body)];
+    if (island < 0) {
+      island = static_cast<std::int64_t>(out.start_.size() - 1);
+      out.start_.push_back(0);
     }
-    islands[static_cast<std::size_t>(island_of_root[root])].push_back(k);
+    out.island_of_row_[k] = island;
+    ++out.start_[static_cast<std::size_t>(island) + 1];
   }
+  for (std::size_t i = 1; i < out.start_.size(); ++i) out.start_[i] += out.start_[i - 1];
+  out.rows_.resize(out.start_.back());
+  // island_of_root_ is free again: reuse it as each island's fill cursor.
+  for (std::size_t i = 0; i + 1 < out.start_.size(); ++i) out.island_of_root_[i] = out.start_[i];
+  for (std::uint32_t k = 0; k < rows.size(); ++k)
+    if (const std::int64_t island = out.island_of_row_[k]; island >= 0)
+      out.rows_[static_cast<std::size_t>(out.island_of_root_[static_cast<std::size_t>(island)]++)] = k;
+}
+
+void IslandSet::merge() {
+  if (size() <= 1) return;
+  std::sort(rows_.begin(), rows_.end());
+  start_.assign({0u, static_cast<std::uint32_t>(rows_.size())});
+}
+
+std::vector<std::vector<std::uint32_t>> find_islands(std::span<const ImpulseRow> rows,
+                                                     std::size_t body_count,
+                                                     std::span<const RigidBody> bodies) {
+  IslandSet set;
+  find_islands(rows, body_count, bodies, set);
+  std::vector<std::vector<std::uint32_t>> islands;
+  for (std::size_t i = 0; i < set.size(); ++i) islands.emplace_back(set.island(i).begin(), set.island(i).end());
   return islands;
 }
 

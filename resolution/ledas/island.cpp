@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <utility>
 
 namespace impetus {
@@ -31,18 +32,18 @@ void Island::measure_complementarity(const Vector& v, const Vector& target_now) 
 // Each coupling is computed once, on and below the diagonal (i ≥ k); an entry above it (i < k) is copied
 // from column i, whose entries below the diagonal are met in increasing row order as k grows. So A is
 // exactly symmetric.
-SparseMatrix assemble_matrix(std::span<const resolution::ImpulseRow> rows, std::span<const std::uint32_t> island,
-                             const resolution::Incidence& incidence) {
+void assemble_matrix(std::span<const resolution::ImpulseRow> rows, std::span<const std::uint32_t> island,
+                     const resolution::Incidence& incidence, SparseMatrix& a, std::vector<int>& below) {
   const std::size_t m = island.size();
   const auto em = static_cast<Eigen::Index>(m);
-  SparseMatrix a(em, em);
+  a.resize(em, em);  // keeps the entries' storage
   std::size_t nonzeros = 0;
   for (std::size_t k = 0; k < m; ++k) nonzeros += incidence.side_rows(k, 0).size() + incidence.side_rows(k, 1).size();
   a.resizeNonZeros(static_cast<Eigen::Index>(nonzeros));
   int* outer = a.outerIndexPtr();
   int* inner = a.innerIndexPtr();
   double* value = a.valuePtr();
-  std::vector<int> below(m);  // per column: where its next entry below the diagonal goes
+  below.resize(m);  // per column: where its next entry below the diagonal goes
   int q = 0;
   for (std::size_t k = 0; k < m; ++k) {
     outer[k] = q;
@@ -65,7 +66,6 @@ SparseMatrix assemble_matrix(std::span<const resolution::ImpulseRow> rows, std::
   }
   outer[m] = q;
   a.resizeNonZeros(q);
-  return a;
 }
 
 double kinetic_energy(std::span<const RigidBody> bodies, std::span<const BodyIndex> which) {
@@ -81,11 +81,16 @@ double kinetic_energy(std::span<const RigidBody> bodies, std::span<const BodyInd
 }  // namespace ledas
 
 // An island's system: its movable bodies, A (eq. 7), each row's target and restitution.
-ledas::Island LedasResolver::make_island(std::vector<std::uint32_t> rows, std::span<const RigidBody> bodies,
-                                         double dt) {
-  ledas::Island island;
-  island.rows = std::move(rows);
+void LedasResolver::make_island(std::span<const std::uint32_t> rows, std::span<const RigidBody> bodies, double dt,
+                                ledas::Island& island) {
+  island.rows.assign(rows.begin(), rows.end());
   island.dt = dt;
+  island.bodies.clear();
+  island.frictional = false;
+  island.complementarity = 0.0;
+  island.rounds = 0;
+  island.joint_gap = std::numeric_limits<double>::infinity();
+  island.velocity_current = false;
   const std::size_t m = island.rows.size();
   const auto em = static_cast<Eigen::Index>(m);
   // The island's movable bodies, increasing, each marked with its slot (reset after the island in resolve_all).
@@ -97,8 +102,8 @@ ledas::Island LedasResolver::make_island(std::vector<std::uint32_t> rows, std::s
       }
   std::sort(island.bodies.begin(), island.bodies.end());
   for (std::size_t s = 0; s < island.bodies.size(); ++s) body_slot_[island.bodies[s]] = static_cast<std::int32_t>(s);
-  island.incidence = resolution::Incidence(rows_, island.rows, island.bodies.size(), body_slot_);
-  island.a = ledas::assemble_matrix(rows_, island.rows, island.incidence);
+  island.incidence.assign(rows_, island.rows, island.bodies.size(), body_slot_);
+  ledas::assemble_matrix(rows_, island.rows, island.incidence, island.a, island.scratch);
   island.equality.resize(m);
   island.role.resize(m);
   island.mu.assign(m, 0.0);
@@ -118,7 +123,6 @@ ledas::Island LedasResolver::make_island(std::vector<std::uint32_t> rows, std::s
         ri.equality ? ri.target : ri.tangent ? 0.0 : resolution::gap_target(ri.depth, dt);
   }
   assign_restitution(island, bodies);
-  return island;
 }
 
 // The rows' velocities v_n (eq. 5) at the bodies' current velocities, recomputed only when stale.

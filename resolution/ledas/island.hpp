@@ -22,7 +22,8 @@ namespace impetus::ledas {
 /// counted as a gain.
 inline constexpr double kRoundoff = 1e-12;
 
-/// One island's working data.
+/// One island's working data. A lane keeps its islands' from step to step (lane.hpp); make_island sets
+/// every field.
 struct Island {
   std::vector<std::uint32_t> rows;    ///< the resolver's rows, increasing
   SparseMatrix a;                     ///< A of eq. 7 over the rows (both triangles)
@@ -48,6 +49,7 @@ struct Island {
   /// changes the island's body velocities without recomputing it).
   Vector velocity;
   bool velocity_current = false;
+  std::vector<int> scratch;  ///< assemble_matrix's
 
   /// Sets `complementarity` = max over contact normal rows of |Σ p · (v_n − target)| at velocities v (after
   /// an inelastic phase).
@@ -58,9 +60,10 @@ struct Island {
   bool bouncing() const { return restitution.size() > 0 && restitution.maxCoeff() > 0.0; }
 };
 
-/// A of eq. 7 over the rows `island` of `rows` (local indices), both triangles stored, exactly symmetric.
-SparseMatrix assemble_matrix(std::span<const resolution::ImpulseRow> rows, std::span<const std::uint32_t> island,
-                             const resolution::Incidence& incidence);
+/// A of eq. 7 over the rows `island` of `rows` (local indices), both triangles stored, exactly symmetric,
+/// into `a` (its storage reused); `below` is scratch.
+void assemble_matrix(std::span<const resolution::ImpulseRow> rows, std::span<const std::uint32_t> island,
+                     const resolution::Incidence& incidence, SparseMatrix& a, std::vector<int>& below);
 
 /// Kinetic energy of the bodies `which` (J).
 double kinetic_energy(std::span<const RigidBody> bodies, std::span<const BodyIndex> which);

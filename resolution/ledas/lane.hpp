@@ -5,6 +5,7 @@
 /// keeps for the next step. The lanes of a step run in parallel; what one lane computes depends only on
 /// the islands dealt to it (ledas.hpp, LedasResolver::kLanes), never on which thread runs it.
 
+#include "island.hpp"
 #include "impetus/resolution/ledas/ledas.hpp"
 
 #include <cstdint>
@@ -22,6 +23,14 @@ struct LedasResolver::Lane {
   ResolverCounters counters;   // likewise
   std::vector<std::int32_t> hops, queue;  // narrow_start_set's distances and search queue (reused)
   std::vector<std::pair<ContactKey, ContactImpulse>> remembered;  // next step's warm starts, island order
+  // The islands' working data, the lane's j-th island of a step in islands[j]: kept from step to step, so
+  // that a stable contact pattern is solved in buffers of the right sizes, without allocating.
+  std::vector<ledas::Island> islands;
+  std::size_t islands_used = 0;  // this step's
+  ledas::Island& next_island() {
+    if (islands_used == islands.size()) islands.emplace_back();
+    return islands[islands_used++];
+  }
 };
 
 }  // namespace impetus

@@ -131,28 +131,24 @@ void LedasResolver::resolve_all(std::span<RigidBody> bodies, std::span<Contact> 
   warm_.swap(next_warm_);
   next_warm_.clear();
   build_rows(bodies, contacts, constraints, ctx.dt, counters);
-  std::vector<std::vector<std::uint32_t>> islands = resolution::find_islands(rows_, bodies.size(), bodies);
+  resolution::find_islands(rows_, bodies.size(), bodies, islands_);
   body_slot_.assign(bodies.size(), -1);
-  if (!settings_.islands && islands.size() > 1) {  // one system for everything (benchmarks/model.cpp)
-    std::vector<std::uint32_t> all;
-    for (const auto& island : islands) all.insert(all.end(), island.begin(), island.end());
-    std::sort(all.begin(), all.end());
-    islands.assign(1, std::move(all));
-  }
+  if (!settings_.islands) islands_.merge();  // one system for everything (benchmarks/model.cpp)
   // Island i goes to lane i mod kLanes; the lanes run in parallel (in the caller's thread arena: the
   // world's `threads`), each on its islands in order. Islands share no movable body, so they write
   // disjoint bodies, contacts and body slots; everything else a lane writes is its own.
-  const std::size_t used = std::min(islands.size(), kLanes);
+  const std::size_t used = std::min(islands_.size(), kLanes);
   for (std::size_t k = 0; k < used; ++k) {
     Lane& l = lane(k);
     l.stats = LedasStats{};
     l.counters = ResolverCounters{};
     l.remembered.clear();
+    l.islands_used = 0;
   }
   const auto run_lanes = [&](const tbb::blocked_range<std::size_t>& range) {
     for (std::size_t k = range.begin(); k != range.end(); ++k)
-      for (std::size_t i = k; i < islands.size(); i += kLanes)
-        solve_island(std::move(islands[i]), bodies, contacts, ctx.dt, *lanes_[k]);
+      for (std::size_t i = k; i < islands_.size(); i += kLanes)
+        solve_island(islands_.island(i), bodies, contacts, ctx.dt, *lanes_[k]);
   };
   if (used > 1) tbb::parallel_for(tbb::blocked_range<std::size_t>(0, used, 1), run_lanes);
   else run_lanes(tbb::blocked_range<std::size_t>(0, used, 1));
@@ -217,9 +213,10 @@ void LedasResolver::build_rows(std::span<const RigidBody> bodies, std::span<Cont
 }
 
 // One island: the velocity phase by mode, its report, then the position correction.
-void LedasResolver::solve_island(std::vector<std::uint32_t> rows, std::span<RigidBody> bodies,
+void LedasResolver::solve_island(std::span<const std::uint32_t> rows, std::span<RigidBody> bodies,
                                  std::span<Contact> contacts, double dt, Lane& lane) {
-  ledas::Island island = make_island(std::move(rows), bodies, dt);
+  ledas::Island& island = lane.next_island();
+  make_island(rows, bodies, dt, island);
   const double energy_before = ledas::kinetic_energy(bodies, island.bodies);
   if (settings_.mode == LedasMode::paper) velocity_paper(island, bodies, lane);
   else if (island.frictional) velocity_frictional(island, bodies, lane);

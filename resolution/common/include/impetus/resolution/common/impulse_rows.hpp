@@ -120,9 +120,34 @@ inline double movable_share_b(const ImpulseRow& row, const RigidBody& b) {
 /// Applies impulse magnitude `p` along the row (eq. 3): −p n on a, +p n on b. Fixed bodies unchanged.
 void apply_row_impulse(const ImpulseRow& row, double p, std::span<RigidBody> bodies);
 
+/// Rows grouped into islands (find_islands), laid out in one array, with the grouping's scratch: kept
+/// from step to step, it allocates only when the rows or bodies outgrow every earlier step's.
+class IslandSet {
+ public:
+  /// How many islands.
+  std::size_t size() const { return start_.empty() ? 0 : start_.size() - 1; }
+  /// Island i's rows, increasing.
+  std::span<const std::uint32_t> island(std::size_t i) const {
+    return {rows_.data() + start_[i], rows_.data() + start_[i + 1]};
+  }
+  /// Makes the islands one: every row of every island, increasing (a single system for everything).
+  void merge();
+
+ private:
+  friend void find_islands(std::span<const ImpulseRow>, std::size_t, std::span<const RigidBody>, IslandSet&);
+  std::vector<std::uint32_t> start_;  // per island, its first entry in rows_; one more at the end
+  std::vector<std::uint32_t> rows_;
+  std::vector<std::uint32_t> parent_;          // union-find over bodies
+  std::vector<std::int64_t> island_of_root_;   // per root body, its island, or −1
+  std::vector<std::int64_t> island_of_row_;    // per row, its island, or −1 (fixed–fixed)
+};
+
 /// Groups rows into islands: rows connected through shared movable bodies (fixed bodies do not
 /// connect). Each island lists row indices in increasing order; islands are ordered by their first
 /// row. Deterministic.
+void find_islands(std::span<const ImpulseRow> rows, std::size_t body_count, std::span<const RigidBody> bodies,
+                  IslandSet& out);
+/// The same as a list of lists (allocates).
 std::vector<std::vector<std::uint32_t>> find_islands(std::span<const ImpulseRow> rows,
                                                      std::size_t body_count,
                                                      std::span<const RigidBody> bodies);

@@ -1,7 +1,8 @@
 #pragma once
 /// \file
 /// Which movable bodies a set of impulse rows joins, both ways: per row its bodies' slots (−1 for a fixed
-/// body), per body slot its rows. The matrix of eq. 7 (A_ik ≠ 0 only where rows i and k share a movable
+/// body), per body slot its rows. Rebuilt in place (assign) from step to step, it allocates only when an
+/// island is larger than any before it. The matrix of eq. 7 (A_ik ≠ 0 only where rows i and k share a movable
 /// body), the paper mode's stale-row tracking, the complementary mode's start set and the sequential
 /// resolver's refresh of v_n all read it.
 
@@ -24,7 +25,12 @@ struct Incidence {
 
   Incidence() = default;
   Incidence(std::span<const ImpulseRow> rows, std::span<const std::uint32_t> island, std::size_t movable,
-            std::span<const std::int32_t> slot_of_body);
+            std::span<const std::int32_t> slot_of_body) {
+    assign(rows, island, movable, slot_of_body);
+  }
+  /// Rebuilds the incidence for another island (the constructor's arguments), reusing the buffers.
+  void assign(std::span<const ImpulseRow> rows, std::span<const std::uint32_t> island, std::size_t movable,
+              std::span<const std::int32_t> slot_of_body);
 
   /// Whether row i's side k (0: a, 1: b) is a movable body not already listed for it as side 0 (a row
   /// joining a body to itself is listed once).
@@ -41,6 +47,9 @@ struct Incidence {
   std::span<const std::uint32_t> side_rows(std::size_t i, std::size_t k) const {
     return listed(i, k) ? rows_of(slots[i][k]) : std::span<const std::uint32_t>();
   }
+
+ private:
+  std::vector<std::uint32_t> cursor_;  // assign's scratch: per slot, where its next row goes
 };
 
 }  // namespace impetus::resolution

@@ -128,9 +128,10 @@ class LedasResolver final : public CollisionResolver {
                    const StepContext& ctx, ResolverCounters& counters);
   void build_rows(std::span<const RigidBody> bodies, std::span<Contact> contacts,
                   std::span<const Constraint> constraints, double dt, ResolverCounters& counters);
-  void solve_island(std::vector<std::uint32_t> rows, std::span<RigidBody> bodies, std::span<Contact> contacts,
+  void solve_island(std::span<const std::uint32_t> rows, std::span<RigidBody> bodies, std::span<Contact> contacts,
                     double dt, Lane& lane);
-  ledas::Island make_island(std::vector<std::uint32_t> rows, std::span<const RigidBody> bodies, double dt);
+  void make_island(std::span<const std::uint32_t> rows, std::span<const RigidBody> bodies, double dt,
+                   ledas::Island& island);
   void assign_restitution(ledas::Island& island, std::span<const RigidBody> bodies);
   const ledas::Vector& current_velocities(ledas::Island& island, std::span<const RigidBody> bodies) const;
   void velocity_paper(ledas::Island& island, std::span<RigidBody> bodies, Lane& lane);
@@ -157,6 +158,7 @@ class LedasResolver final : public CollisionResolver {
   LedasStats stats_;
   std::vector<resolution::ImpulseRow> rows_;  // this step's rows: contacts first, then joint rows
   std::vector<ledas::RowInfo> info_;
+  resolution::IslandSet islands_;            // this step's islands (rows_ indices)
   resolution::InverseInertiaCache inertia_;  // the bodies' J⁻¹ while this step's rows are built
   std::vector<std::int32_t> body_slot_;  // per body: its slot in its island's movable bodies, or −1
   // Warm starts: a frictional contact's inelastic impulse (normal; tangential as a world vector) by its
