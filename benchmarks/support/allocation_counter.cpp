@@ -1,6 +1,8 @@
-// The global operator new and delete, replaced for one program so that allocation_counter.hpp can count
-// allocations: each form of new adds one to a relaxed atomic counter and takes its memory from malloc
-// (aligned_alloc for over-aligned types); every delete frees it.
+// The global operator new and delete, and C's malloc, calloc and realloc, replaced for one program so that
+// allocation_counter.hpp can count allocations. malloc, calloc and realloc add one to a relaxed atomic
+// counter and call glibc's own (__libc_malloc, …), whose free frees them; each form of new takes its
+// memory from malloc (counted there) or, over-aligned, from aligned_alloc (counted in new); every delete
+// frees it. Under AddressSanitizer the sanitizer owns malloc: only new is counted (counts_malloc()).
 #include "support/allocation_counter.hpp"
 
 #include <atomic>
@@ -8,14 +10,53 @@
 #include <cstdlib>
 #include <new>
 
+#if defined(__SANITIZE_ADDRESS__)
+#define IMPETUS_COUNT_MALLOC 0
+#elif defined(__has_feature)
+#if __has_feature(address_sanitizer)
+#define IMPETUS_COUNT_MALLOC 0
+#endif
+#endif
+#ifndef IMPETUS_COUNT_MALLOC
+#define IMPETUS_COUNT_MALLOC 1
+#endif
+
 namespace {
 
 std::atomic<std::uint64_t> g_count{0};
 
+void count() noexcept { g_count.fetch_add(1, std::memory_order_relaxed); }
+
+}  // namespace
+
+#if IMPETUS_COUNT_MALLOC
+extern "C" {
+void* __libc_malloc(std::size_t size);
+void* __libc_calloc(std::size_t count, std::size_t size);
+void* __libc_realloc(void* p, std::size_t size);
+
+void* malloc(std::size_t size) {
+  count();
+  return __libc_malloc(size);
+}
+void* calloc(std::size_t n, std::size_t size) {
+  count();
+  return __libc_calloc(n, size);
+}
+void* realloc(void* p, std::size_t size) {
+  count();
+  return __libc_realloc(p, size);
+}
+}
+#endif
+
+namespace {
+
 void* counted(std::size_t size, std::size_t alignment) {
-  g_count.fetch_add(1, std::memory_order_relaxed);
+  const bool over_aligned = alignment > alignof(std::max_align_t);
+  if (!IMPETUS_COUNT_MALLOC || over_aligned) count();  // else malloc counts it
   if (size == 0) size = 1;
-  void* p = alignment > alignof(std::max_align_t)
+  void* p = over_aligned
                 ? std::aligned_alloc(alignment, (size + alignment - 1) / alignment * alignment)
                 : std::malloc(size);
   return p;
@@ -31,6 +72,7 @@ void* counted_or_throw(std::size_t size, std::size_t alignment) {
 
 namespace impetus::bench {
 std::uint64_t allocations() noexcept { return g_count.load(std::memory_order_relaxed); }
+bool counts_malloc() noexcept { return IMPETUS_COUNT_MALLOC != 0; }
 }  // namespace impetus::bench
 
 void* operator new(std::size_t size) { return counted_or_throw(size, alignof(std::max_align_t)); }

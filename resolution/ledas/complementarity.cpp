@@ -80,30 +80,29 @@ void ComplementaritySolver::factorize_loop(ActiveLoop& loop, const SparseMatrix&
 // Solves (A + εI)_FF z = r_F for the free rows F: by the current factorization when F is the one it
 // holds, by an update when only a few rows changed, else by a new masked factorization (same symbolic
 // analysis). A + εI is positive definite, so every free set has exactly one solution.
-Vector ComplementaritySolver::solve_active(const SparseMatrix& a, double shift, const Vector& r, const std::vector<char>& active,
-                                  ActiveLoop& loop, SolverStats& stats) {
+void ComplementaritySolver::solve_active(const SparseMatrix& a, double shift, const Vector& r,
+                                         const std::vector<char>& active, ActiveLoop& loop, SolverStats& stats,
+                                         Vector& z) {
   if (loop.factored) {
     std::size_t changes = 0;
     for (std::size_t k = 0; k < active.size(); ++k) changes += (active[k] != 0) != (loop.in_base[k] != 0);
     if (changes == 0) {
-      Vector z = r;
+      z = r;
       loop.factor->solve(z);
-      return z;
+      return;
     }
-    Vector z;
     const std::size_t limit = settings_.update_limit > 0
                                   ? settings_.update_limit
                                   : std::max<std::size_t>(8, static_cast<std::size_t>(std::sqrt(static_cast<double>(active.size()))));
     if (changes <= limit && loop.update.solve(*loop.factor, loop.in_base, a, shift, r, active, settings_.rank_tolerance, z)) {
       ++stats.updated;
-      return z;
+      return;
     }
   }
   factorize_loop(loop, a, active, shift, stats);
   loop.singular = loop.singular || loop.factor->redundant_rows(shift) > 0;
-  Vector z = r;
+  z = r;
   loop.factor->solve(z);
-  return z;
 }
 
 // The state of one proximal active-set search (solve()): the free set F, the iterate p, the proximal
@@ -111,16 +110,25 @@ Vector ComplementaritySolver::solve_active(const SparseMatrix& a, double shift, 
 struct ComplementaritySolver::Search {
   enum class Outcome { running, converged, not_finite, stalled };
 
-  Search(const ComplementarityProblem& problem_in, const SolverSettings& settings, double scale_in,
-         std::vector<char> free_in)
+  // The vectors and the free set are the workspace's (`free_rows` filled by the caller); the loop borrows
+  // its base set's storage from it until the search ends.
+  Search(const ComplementarityProblem& problem_in, const SolverSettings& settings, double scale_in, Workspace& work)
       : problem(problem_in), scale(scale_in), final_shift(settings.regularization * scale_in),
         search_shift(std::max(final_shift, settings.search_regularization * scale_in)), shift(final_shift),
-        free_rows(std::move(free_in)), p(Vector::Zero(problem_in.matrix->rows())),
-        center(Vector::Zero(problem_in.matrix->rows())), r(problem_in.rhs), w(problem_in.matrix->rows()),
+        workspace(work), free_rows(work.free_rows), p(work.p), center(work.center), r(work.r), w(work.w), z(work.z),
         fewest_infeasible(free_rows.size() + 1) {
+    const Eigen::Index m = problem_in.matrix->rows();
+    p.setZero(m);
+    center.setZero(m);
+    r = problem_in.rhs;
+    w.resize(m);
     loop.floor = settings.rank_tolerance * scale;
+    loop.in_base.swap(work.in_base);
     loop.in_base.assign(free_rows.size(), 0);
   }
+  ~Search() { loop.in_base.swap(workspace.in_base); }
+  Search(const Search&) = delete;
+  Search& operator=(const Search&) = delete;
   bool done() const { return outcome != Outcome::running; }
   // A free inequality row whose subproblem impulse z_k is negative (below rounding).
   bool negative(std::size_t k, double roundoff) const {
@@ -155,8 +163,9 @@ struct ComplementaritySolver::Search {
   const double search_shift;  // ε while the active set is searched (search_regularization · scale)
   double shift;               // the current ε
   ActiveLoop loop;
-  std::vector<char> free_rows;       // F
-  Vector p, center, r, w, z;         // iterate, p̄, c + ε p̄, A z − c, the subproblem's solution on F
+  Workspace& workspace;
+  std::vector<char>& free_rows;      // F
+  Vector &p, &center, &r, &w, &z;    // iterate, p̄, c + ε p̄, A z − c, the subproblem's solution on F
   Outcome outcome = Outcome::running;
   double last_change = std::numeric_limits<double>::infinity();  // ε |p − p̄| of the last outer iteration
   int slow = 0;                      // outer iterations in a row that shrank it by less than 10 %
@@ -195,19 +204,21 @@ struct ComplementaritySolver::Search {
 // among redundant contacts, which moves nothing) stays near zero, i.e. near the minimum-norm split. If
 // the outer residual stops shrinking short of the tolerance (conflicting targets: no exact solution),
 // solve_min_norm (the fallback) takes over.
-Vector ComplementaritySolver::solve(const ComplementarityProblem& problem, SolverStats& stats) {
+void ComplementaritySolver::solve(const ComplementarityProblem& problem, SolverStats& stats, Vector& p) {
+  work_ = problem.workspace ? problem.workspace : &own_;
   const SparseMatrix& a = *problem.matrix;
   const auto m = static_cast<std::size_t>(a.rows());
-  std::vector<char> free_rows(m);
+  std::vector<char>& free_rows = work_->free_rows;
+  free_rows.resize(m);
   for (std::size_t k = 0; k < m; ++k) free_rows[k] = problem.equality[k] || problem.start[k];
-  Vector p = Vector::Zero(a.rows());
-  if (m == 0) return p;
-  work_.diagonal = a.diagonal();
-  const double scale = work_.diagonal.maxCoeff();
+  p.setZero(a.rows());
+  if (m == 0) return;
+  work_->diagonal = a.diagonal();
+  const double scale = work_->diagonal.maxCoeff();
   if (!(scale > 0.0) || !std::isfinite(scale)) {  // nothing movable behind any row
     ++stats.singular;
     if (!std::isfinite(scale) || problem.rhs.lpNorm<Eigen::Infinity>() > 0.0) ++stats.inconsistent;
-    return p;
+    return;
   }
   if (m == 1) {  // closed form: p = c / A_11, clamped at 0 for a contact (identical to the paper mode's)
     const double a11 = a.coeff(0, 0);
@@ -218,9 +229,9 @@ Vector ComplementaritySolver::solve(const ComplementarityProblem& problem, Solve
       if (p(0) < 0.0) ++stats.released;
       p(0) = 0.0;
     }
-    return p;
+    return;
   }
-  Search search(problem, settings_, scale, std::move(free_rows));
+  Search search(problem, settings_, scale, *work_);
   search.loop.factor = checkout_masked(a, search.free_rows, stats);
   const std::uint64_t budget = work_budget(m, settings_);
   for (std::uint64_t iteration = 0; iteration < budget && !search.done(); ++iteration)
@@ -233,13 +244,16 @@ Vector ComplementaritySolver::solve(const ComplementarityProblem& problem, Solve
     ++stats.singular;
     if (search.outcome != Search::Outcome::converged && search.outcome != Search::Outcome::stalled) ++stats.inconsistent;
   }
-  if (search.outcome == Search::Outcome::stalled) return solve_min_norm(problem, stats);
+  if (search.outcome == Search::Outcome::stalled) {
+    p = solve_min_norm(problem, stats);
+    return;
+  }
   if (search.outcome == Search::Outcome::running) ++stats.non_converged;
   if (search.outcome != Search::Outcome::converged)  // the last iterate may be infeasible
     clamp_to_free_set(search.p, search.free_rows, problem.equality);
   else
     polish_minimum_norm(a, problem.rhs, search.free_rows, problem, search.p, stats);
-  return std::move(search.p);
+  p.swap(search.p);  // the caller's old storage becomes the workspace's
 }
 
 // One iteration of the search: solve the subproblem on F, then change F (block pivoting, or a primal
@@ -247,7 +261,7 @@ Vector ComplementaritySolver::solve(const ComplementarityProblem& problem, Solve
 void ComplementaritySolver::iterate(Search& s, std::uint64_t iteration, SolverStats& stats) {
   const SparseMatrix& a = *s.problem.matrix;
   ++stats.iterations;
-  s.z = solve_active(a, s.shift, s.r, s.free_rows, s.loop, stats);
+  solve_active(a, s.shift, s.r, s.free_rows, s.loop, stats, s.z);
   if (!s.z.allFinite()) {
     ++stats.nan_caught;
     s.p.setZero();
@@ -277,7 +291,8 @@ void ComplementaritySolver::iterate(Search& s, std::uint64_t iteration, SolverSt
   }
   if (negatives > 0) {
     // Primal step: towards z until the first free row reaches zero; release the rows at zero.
-    const Vector direction = s.z - s.p;
+    Vector& direction = s.workspace.direction;  // free here: the refinement's, between refinements
+    direction = s.z - s.p;
     const RatioTest test = ratio_test(s.p, direction, s.free_rows, s.problem.equality, 1.0);
     step_and_release(s.p, direction, test, s.z, roundoff, s.free_rows, s.problem.equality, stats);
     return;
@@ -297,10 +312,11 @@ void ComplementaritySolver::settle(Search& s, SolverStats& stats) {
   const ComplementarityProblem& problem = s.problem;
   const Vector& c = problem.rhs;
   {
-    Vector x = s.p;
+    Vector& x = s.workspace.x;
+    x = s.p;
     if (refine_on_free_set(*problem.matrix, c, s.shift, s.free_rows, s.loop, problem, x, stats) ==
         Refinement::exact) {
-      s.p = std::move(x);
+      s.p.swap(x);
       s.outcome = Search::Outcome::converged;
       return;
     }
@@ -352,10 +368,10 @@ ComplementaritySolver::Refinement ComplementaritySolver::refine_on_free_set(cons
   const auto m = free_rows.size();
   bool by_update = prepare_preconditioner(a, shift, free_rows, loop, stats);
   mark_solved_rows(free_rows, loop);
-  Vector& residual = work_.residual;
-  Vector& preconditioned = work_.preconditioned;
-  Vector& direction = work_.direction;
-  Vector& product = work_.product;
+  Vector& residual = work_->residual;
+  Vector& preconditioned = work_->preconditioned;
+  Vector& direction = work_->direction;
+  Vector& product = work_->product;
   restrict_to_solved(x);
   residual.noalias() = -(a * x);
   residual += c;
@@ -363,7 +379,7 @@ ComplementaritySolver::Refinement ComplementaritySolver::refine_on_free_set(cons
   precondition(loop, by_update, residual, preconditioned);
   direction = preconditioned;
   double rz = residual.dot(preconditioned);
-  const double scale = work_.diagonal.maxCoeff();
+  const double scale = work_->diagonal.maxCoeff();
   const double final_shift = settings_.regularization * scale;
   // Multiply-adds of one step: a solve (forward and backward over L), a product with A, vector updates.
   const double step_cost = 2.0 * static_cast<double>(loop.factor->capacity()) + static_cast<double>(a.nonZeros()) +
@@ -436,18 +452,18 @@ void ComplementaritySolver::precondition(ActiveLoop& loop, bool by_update, const
 // factorization leaves them); the others listed, to be zeroed by index (no branch per row).
 void ComplementaritySolver::mark_solved_rows(const std::vector<char>& free_rows, const ActiveLoop& loop) {
   const std::size_t m = free_rows.size();
-  std::vector<char>& solved_rows = work_.solved_rows;
+  std::vector<char>& solved_rows = work_->solved_rows;
   solved_rows.resize(m);
   for (std::size_t k = 0; k < m; ++k)
-    solved_rows[k] = free_rows[k] && work_.diagonal(static_cast<Eigen::Index>(k)) > loop.floor;
-  std::vector<Eigen::Index>& unsolved = work_.unsolved_rows;
+    solved_rows[k] = free_rows[k] && work_->diagonal(static_cast<Eigen::Index>(k)) > loop.floor;
+  std::vector<Eigen::Index>& unsolved = work_->unsolved_rows;
   unsolved.clear();
   for (std::size_t k = 0; k < m; ++k)
     if (!solved_rows[k]) unsolved.push_back(static_cast<Eigen::Index>(k));
 }
 
 void ComplementaritySolver::restrict_to_solved(Vector& v) const {
-  for (const Eigen::Index k : work_.unsolved_rows) v(k) = 0.0;
+  for (const Eigen::Index k : work_->unsolved_rows) v(k) = 0.0;
 }
 
 // The preconditioned matrix has the eigenvalues λ/(λ + ε): many eigenvalues of A_FF below ε (a large,
@@ -466,15 +482,15 @@ bool ComplementaritySolver::sharpening_pays(double reduction, double remaining, 
 ComplementaritySolver::Refinement ComplementaritySolver::accept_refined(const SparseMatrix& a, const Vector& c,
                                                                         const ComplementarityProblem& problem,
                                                                         Vector& x) {
-  const std::size_t m = work_.solved_rows.size();
-  Vector& product = work_.product;
+  const std::size_t m = work_->solved_rows.size();
+  Vector& product = work_->product;
   product.noalias() = a * x;
   product -= c;  // w
   const double roundoff = kImpulseRoundoff * x.lpNorm<Eigen::Infinity>();
   for (std::size_t k = 0; k < m; ++k) {
     if (problem.equality[k]) continue;
     const auto i = static_cast<Eigen::Index>(k);
-    if (work_.solved_rows[k] ? x(i) < -roundoff : product(i) < -problem.tolerance) return Refinement::infeasible;
+    if (work_->solved_rows[k] ? x(i) < -roundoff : product(i) < -problem.tolerance) return Refinement::infeasible;
   }
   for (std::size_t k = 0; k < m; ++k)
     if (!problem.equality[k]) x(static_cast<Eigen::Index>(k)) = std::max(0.0, x(static_cast<Eigen::Index>(k)));

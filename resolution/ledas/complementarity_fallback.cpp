@@ -133,7 +133,7 @@ Vector ComplementaritySolver::solve_min_norm(const ComplementarityProblem& probl
 // it, take the minimum-norm one (the paper's choice for its Figure 2: the impulse shared equally among
 // collinear contacts) if it keeps every impulse ≥ 0. It changes no velocity: p − p_min is a
 // self-equilibrated impulse set (A (p − p_min) = 0).
-void ComplementaritySolver::polish_minimum_norm(const SparseMatrix& a, const Vector& c, std::vector<char> rows,
+void ComplementaritySolver::polish_minimum_norm(const SparseMatrix& a, const Vector& c, std::vector<char>& rows,
                                        const ComplementarityProblem& problem, Vector& p, SolverStats& stats) {
   for (std::size_t k = 0; k < rows.size(); ++k)  // rows at zero with w = 0 may share the impulse too
     if (!rows[k] && !problem.equality[k]) {
@@ -141,7 +141,8 @@ void ComplementaritySolver::polish_minimum_norm(const SparseMatrix& a, const Vec
       for (SparseMatrix::InnerIterator it(a, static_cast<Eigen::Index>(k)); it; ++it) w += it.value() * p(it.row());
       rows[k] = std::abs(w) <= 0.5 * problem.tolerance;
     }
-  const std::vector<RowIndex> members_f = members(rows);
+  std::vector<RowIndex>& members_f = work_->members;
+  members(rows, members_f);
   if (members_f.size() < 2 || members_f.size() > settings_.polish_limit) return;
   SolverStats ignored;
   const SparseMatrix sub = principal_submatrix(a, members_f);

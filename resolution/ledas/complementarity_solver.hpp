@@ -25,8 +25,8 @@ class ComplementaritySolver {
   ComplementaritySolver(const ComplementaritySolver&) = delete;
   ComplementaritySolver& operator=(const ComplementaritySolver&) = delete;
 
-  /// IslandSolver::solve_complementarity.
-  Vector solve(const ComplementarityProblem& problem, SolverStats& stats);
+  /// IslandSolver::solve_complementarity, into p.
+  void solve(const ComplementarityProblem& problem, SolverStats& stats, Vector& p);
 
  private:
   struct ActiveLoop;  // one active-set loop's factorization and update (solver_internal.hpp)
@@ -37,8 +37,8 @@ class ComplementaritySolver {
   void settle(Search& search, SolverStats& stats);
   void factorize_loop(ActiveLoop& loop, const SparseMatrix& a, const std::vector<char>& rows, double shift,
                       SolverStats& stats);
-  Vector solve_active(const SparseMatrix& a, double shift, const Vector& r, const std::vector<char>& active,
-                      ActiveLoop& loop, SolverStats& stats);
+  void solve_active(const SparseMatrix& a, double shift, const Vector& r, const std::vector<char>& active,
+                    ActiveLoop& loop, SolverStats& stats, Vector& z);
   Refinement refine_on_free_set(const SparseMatrix& a, const Vector& c, double shift, const std::vector<char>& free_rows,
                                 ActiveLoop& loop, const ComplementarityProblem& problem, Vector& x, SolverStats& stats);
   bool prepare_preconditioner(const SparseMatrix& a, double shift, const std::vector<char>& free_rows, ActiveLoop& loop,
@@ -49,7 +49,7 @@ class ComplementaritySolver {
   bool sharpening_pays(double reduction, double remaining, double step_cost, const ActiveLoop& loop) const;
   Refinement accept_refined(const SparseMatrix& a, const Vector& c, const ComplementarityProblem& problem, Vector& x);
   Vector solve_min_norm(const ComplementarityProblem& problem, SolverStats& stats);
-  void polish_minimum_norm(const SparseMatrix& a, const Vector& c, std::vector<char> rows,
+  void polish_minimum_norm(const SparseMatrix& a, const Vector& c, std::vector<char>& rows,
                            const ComplementarityProblem& problem, Vector& p, SolverStats& stats);
   /// A masked factorization of m's pattern: the cached one if there is one (analysed for the rows of an
   /// earlier start set: factorize_loop widens it when a free set needs more), else a new analysis for
@@ -57,16 +57,12 @@ class ComplementaritySolver {
   std::unique_ptr<MaskedLdlt> checkout_masked(const SparseMatrix& m, std::span<const char> likely, SolverStats& stats);
   void checkin_masked(std::unique_ptr<MaskedLdlt> factor);
 
-  struct Workspace {  // reused buffers
-    Vector diagonal;  // A_kk of the problem being solved
-    Vector residual, preconditioned, direction, product;  // refine_on_free_set
-    std::vector<char> solved_rows;
-    std::vector<Eigen::Index> unsolved_rows;
-  };
+  using Workspace = ComplementarityWorkspace;
   const SolverSettings& settings_;
   EqualitySolver& equalities_;
   std::vector<std::unique_ptr<MaskedLdlt>> masked_cache_;  // by pattern, least recently used first
-  Workspace work_;
+  Workspace own_;               // the buffers of a problem that brings none
+  Workspace* work_ = &own_;     // the current solve's: the problem's workspace, or own_
 };
 
 }  // namespace impetus::ledas

@@ -13,16 +13,18 @@ using ledas::Vector;
 // approach again (a separating contact pushed shut gets −e v_n⁻), so the round repeats while any does.
 void LedasResolver::velocity_complementary(ledas::Island& island, std::span<RigidBody> bodies, Lane& lane) {
   const std::size_t m = island.rows.size();
-  ledas::ComplementarityProblem problem;
+  ledas::ComplementarityProblem& problem = island.impact;
+  problem.workspace = &island.impact_work;
   problem.matrix = &island.a;
-  problem.equality = island.equality;
-  problem.start.resize(m);
+  problem.equality.assign(island.equality.begin(), island.equality.end());
+  problem.start.assign(m, 0);
   problem.tolerance = settings_.tolerance;
   const std::uint64_t failed_before = lane.stats.velocity.infeasible, unconverged_before = lane.stats.velocity.non_converged;
   for (std::uint64_t round = 0;; ++round) {
     const Vector& v = current_velocities(island, bodies);  // (finish_round changes it: not used after)
     bool needed = ledas::retarget_joints(island, rows_, info_, v, bodies) && round > 0;
-    Vector target = island.target;
+    Vector& target = island.impact_target;
+    target = island.target;
     for (std::size_t i = 0; i < m; ++i) {
       const auto ei = static_cast<Eigen::Index>(i);
       if (island.equality[i]) {
@@ -49,7 +51,8 @@ void LedasResolver::velocity_complementary(ledas::Island& island, std::span<Rigi
     if (settings_.start_set == LedasStartSet::impact) narrow_start_set(lane, island, v, problem.start);
     problem.rhs = target - v;
     const std::uint64_t before = lane.stats.velocity.iterations;
-    const Vector p = lane.solver.solve_complementarity(problem, lane.stats.velocity);
+    Vector& p = island.impact_solution;
+    lane.solver.solve_complementarity(problem, lane.stats.velocity, p);
     lane.stats.systems += lane.stats.velocity.iterations - before;
     for (std::size_t i = 0; i < m; ++i)
       if (p(static_cast<Eigen::Index>(i)) != 0.0) island.entered[i] = 1;

@@ -51,6 +51,14 @@ struct Island {
   bool velocity_current = false;
   std::vector<int> scratch;  ///< assemble_matrix's
 
+  /// The complementarity problems of the impact (complementary mode) and of the position correction,
+  /// with their solves' buffers, the impact's targets and the solutions: rebuilt in place each step, so
+  /// that an island whose size does not change is solved without allocating (Eigen reallocates a vector
+  /// whose size changes).
+  ComplementarityProblem impact, correction;
+  ComplementarityWorkspace impact_work, correction_work;
+  Vector impact_target, impact_solution, correction_solution;
+
   /// Sets `complementarity` = max over contact normal rows of |Σ p · (v_n − target)| at velocities v (after
   /// an inelastic phase).
   void measure_complementarity(const Vector& v, const Vector& target_now);

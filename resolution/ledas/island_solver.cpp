@@ -66,25 +66,35 @@ void IslandSolver::solve_subset(const SparseMatrix& a, const Vector& c, std::spa
 // tolerance becomes tolerance · min S (so w ≥ −tolerance still holds on every row). Only for spreads
 // beyond kScaleSpread: ordinary problems are solved exactly as before, bit for bit.
 Vector IslandSolver::solve_complementarity(const ComplementarityProblem& problem, SolverStats& stats) {
-  Vector p = solve_balanced(problem, stats);
+  Vector p;
+  solve_complementarity(problem, stats, p);
+  return p;
+}
+
+void IslandSolver::solve_complementarity(const ComplementarityProblem& problem, SolverStats& stats, Vector& p) {
+  solve_balanced(problem, stats, p);
   // An answer whose velocity changes A p dwarf every change the problem asks for (‖c‖) is rounding
   // blown up along a null direction of conflicting targets (a body pinned by a joint deep inside the
   // ground: the joint's and the contact's rows are parallel), not physics: refused, nothing applied.
   const double asked = problem.rhs.lpNorm<Eigen::Infinity>() + problem.tolerance;
-  if (p.size() > 0 && !((*problem.matrix * p).lpNorm<Eigen::Infinity>() <= kAbsurdGain * asked)) {
+  Vector& change = problem.workspace ? problem.workspace->check : check_;
+  if (p.size() > 0) change.noalias() = *problem.matrix * p;
+  if (p.size() > 0 && !(change.lpNorm<Eigen::Infinity>() <= kAbsurdGain * asked)) {
     ++stats.refused;
     ++stats.non_converged;
     p.setZero();
   }
-  return p;
 }
 
-Vector IslandSolver::solve_balanced(const ComplementarityProblem& problem, SolverStats& stats) {
+void IslandSolver::solve_balanced(const ComplementarityProblem& problem, SolverStats& stats, Vector& p) {
   const SparseMatrix& a = *problem.matrix;
   double hi = 0.0, lo = std::numeric_limits<double>::infinity();
   for (Eigen::Index k = 0; k < a.rows(); ++k)
     if (const double d = a.coeff(k, k); d > 0.0 && std::isfinite(d)) hi = std::max(hi, d), lo = std::min(lo, d);
-  if (!(hi > kScaleSpread * lo)) return complementarity_->solve(problem, stats);
+  if (!(hi > kScaleSpread * lo)) {
+    complementarity_->solve(problem, stats, p);
+    return;
+  }
   Vector scale = Vector::Ones(a.rows());
   for (Eigen::Index k = 0; k < a.rows(); ++k)
     if (const double d = a.coeff(k, k); d > 0.0 && std::isfinite(d)) scale(k) = 1.0 / std::sqrt(d);
@@ -93,7 +103,8 @@ Vector IslandSolver::solve_balanced(const ComplementarityProblem& problem, Solve
   balanced.matrix = &scaled;
   balanced.rhs = scale.cwiseProduct(problem.rhs);
   balanced.tolerance = problem.tolerance / std::sqrt(hi);
-  return scale.cwiseProduct(complementarity_->solve(balanced, stats));
+  complementarity_->solve(balanced, stats, p);
+  p = scale.cwiseProduct(p);
 }
 
 void add(SolverStats& into, const SolverStats& part) {

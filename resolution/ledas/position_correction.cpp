@@ -22,7 +22,8 @@ constexpr double kPositionTolerance = 1e-12;
 // an island with friction leaves its tangent rows out (A restricted to the other rows), so the
 // correction never pushes a body along a slope.
 void LedasResolver::correct_positions(ledas::Island& island, std::span<RigidBody> bodies, Lane& lane) {
-  std::vector<ledas::RowIndex> kept;  // local rows of the correction problem (all but tangent rows)
+  std::vector<ledas::RowIndex>& kept = lane.kept;  // local rows of the correction problem (all but tangent rows)
+  kept.clear();
   ledas::SparseMatrix restricted;
   if (island.frictional) {
     for (std::size_t i = 0; i < island.rows.size(); ++i)
@@ -31,11 +32,12 @@ void LedasResolver::correct_positions(ledas::Island& island, std::span<RigidBody
   }
   const auto local = [&](std::size_t j) { return island.frictional ? kept[j] : j; };
   const std::size_t m = island.frictional ? kept.size() : island.rows.size();
-  ledas::ComplementarityProblem problem;
+  ledas::ComplementarityProblem& problem = island.correction;
+  problem.workspace = &island.correction_work;
   problem.matrix = island.frictional ? &restricted : &island.a;
-  problem.equality.resize(m);
-  problem.start.resize(m);
-  problem.rhs = ledas::Vector::Zero(static_cast<Eigen::Index>(m));
+  problem.equality.assign(m, 0);
+  problem.start.assign(m, 0);
+  problem.rhs.setZero(static_cast<Eigen::Index>(m));
   problem.tolerance = kPositionTolerance;
   bool needed = false;
   double total_target = 0.0;  // Σ targets: the displacement bound's scale (resting.hpp)
@@ -53,7 +55,8 @@ void LedasResolver::correct_positions(ledas::Island& island, std::span<RigidBody
   }
   if (!needed) return;
   const std::uint64_t refused_before = lane.stats.position.refused;
-  ledas::Vector q = lane.solver.solve_complementarity(problem, lane.stats.position);
+  ledas::Vector& q = island.correction_solution;
+  lane.solver.solve_complementarity(problem, lane.stats.position, q);
   // No correction moves a body absurdly far (conflicting targets: a body pinned deep in the ground).
   std::vector<const resolution::ImpulseRow*> rows(m);
   for (std::size_t j = 0; j < m; ++j) rows[j] = &rows_[island.rows[local(j)]];

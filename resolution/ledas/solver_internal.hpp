@@ -37,11 +37,16 @@ inline Vector gather(const Vector& v, std::span<const RowIndex> rows) {
   return out;
 }
 
-/// The indices k with flags[k] set, increasing.
-inline std::vector<RowIndex> members(const std::vector<char>& flags) {
-  std::vector<RowIndex> out;
+/// The indices k with flags[k] set, increasing, into `out` (its storage reused).
+inline void members(const std::vector<char>& flags, std::vector<RowIndex>& out) {
+  out.clear();
   for (std::size_t k = 0; k < flags.size(); ++k)
     if (flags[k]) out.push_back(static_cast<RowIndex>(k));
+}
+/// The same, returned.
+inline std::vector<RowIndex> members(const std::vector<char>& flags) {
+  std::vector<RowIndex> out;
+  members(flags, out);
   return out;
 }
 

@@ -88,12 +88,27 @@ void add(SolverStats& into, const SolverStats& part);
 /// One island's complementarity problem: find p with w = A p − c and
 ///   equality rows: w = 0, p free;   the other rows: p ≥ 0, w ≥ −tolerance, p·w = 0.
 /// For the velocity phase p are impulses (N·s), c = target − v_n⁻ and w = v_n⁺ − target (m/s).
+/// The buffers a complementarity solve works in. Eigen resizes a vector by reallocating it, so a caller
+/// that solves problems of one size again and again (an island, step after step) keeps one workspace
+/// per problem and hands it in (ComplementarityProblem::workspace): the solve then allocates nothing.
+struct ComplementarityWorkspace {
+  Vector diagonal;                                  ///< A_kk
+  Vector p, center, r, w, z;                        ///< the search's iterate, p̄, c + ε p̄, A z − c, subproblem solution
+  Vector x;                                         ///< a refinement's iterate
+  Vector residual, preconditioned, direction, product;  ///< the refinement's conjugate gradients
+  Vector check;                                     ///< A p of the final check (IslandSolver)
+  std::vector<char> free_rows, in_base, solved_rows;
+  std::vector<Eigen::Index> unsolved_rows;
+  std::vector<RowIndex> members;                    ///< the polish's free rows
+};
+
 struct ComplementarityProblem {
   const SparseMatrix* matrix = nullptr;  ///< A (m × m), symmetric PSD, both triangles stored
   Vector rhs;                            ///< c (m)
   std::vector<char> equality;            ///< per row: an equality row (constraint), never released
   std::vector<char> start;               ///< per row: in the first active set (approaching or touching)
   double tolerance = 1e-9;               ///< w below −tolerance is a violation (units of w)
+  ComplementarityWorkspace* workspace = nullptr;  ///< buffers to solve in (null: the solver's own)
 };
 
 /// Solves island systems exactly: two solvers behind one interface, the equality solver of the paper
@@ -126,14 +141,18 @@ class IslandSolver {
   /// at most polish_limit rows and that split is ≥ 0. Conflicting targets (no exact solution): the
   /// minimum-norm least-squares active set (complementarity_fallback.cpp).
   Vector solve_complementarity(const ComplementarityProblem& problem, SolverStats& stats);
+  /// The same into `p` (its storage reused: with the problem's workspace, nothing is allocated when the
+  /// sizes are those of the last call).
+  void solve_complementarity(const ComplementarityProblem& problem, SolverStats& stats, Vector& p);
 
   const SolverSettings& settings() const { return settings_; }
 
  private:
   // solve_complementarity without the final check: diagonally scaled where A_kk spans too much.
-  Vector solve_balanced(const ComplementarityProblem& problem, SolverStats& stats);
+  void solve_balanced(const ComplementarityProblem& problem, SolverStats& stats, Vector& p);
   SolverSettings settings_;
   std::unique_ptr<EqualitySolver> equalities_;               // solve_subset (equality_solver.cpp)
+  Vector check_;  // solve_complementarity's A p without a workspace
   std::unique_ptr<ComplementaritySolver> complementarity_;  // solve_complementarity (complementarity.cpp)
 };
 
