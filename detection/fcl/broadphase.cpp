@@ -86,6 +86,7 @@ void Broadphase::finish() {
   impl_->fixed.registerObjects(fixed);
   impl_->movable.setup();
   impl_->fixed.setup();
+  impl_->moved.reserve(movable.size());  // move() then never allocates
 }
 
 void Broadphase::move(BodyIndex index, const Aabb& box, double slack) {

@@ -8,13 +8,13 @@
 #include "impetus/detection/fcl/shapes.hpp"
 
 #include <tbb/blocked_range.h>
-#include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
 #include <limits>
 #include <unordered_map>
 #include <chrono>
+#include <deque>
 #include <cmath>
 #include <exception>
 #include <map>
@@ -125,9 +125,10 @@ struct FclDetector::Impl {
   double thinnest = 0.0;                // the smallest inner radius of any body (m)
   Broadphase broadphase;
   std::vector<BodyPair> pairs;
-  // The narrowphase runs on consecutive runs of kPairsPerChunk pairs in parallel, each thread with its
-  // own scratch; a chunk's contacts and counts are its own, and the chunks are joined in pair order, so
-  // the list is the same for every thread count.
+  // The narrowphase runs on consecutive runs of kPairsPerChunk pairs in parallel; a chunk's scratch,
+  // contacts and counts are its own, and the chunks are joined in pair order, so the list is the same for
+  // every thread count. The scratch is the chunk's, not the thread's: the same pairs find buffers of the
+  // sizes they needed at the last step, whichever thread runs them, so a stable scene allocates nothing.
   struct Worker {
     PairSettings pair;
     std::vector<ManifoldPoint> points;
@@ -136,12 +137,12 @@ struct FclDetector::Impl {
     std::uint64_t fcl_failures = 0;
   };
   struct Chunk {
+    Worker scratch;
     std::vector<Contact> contacts;
     std::uint64_t calls = 0, dropped = 0, speculative = 0;
   };
   static constexpr std::size_t kPairsPerChunk = 32;
-  tbb::enumerable_thread_specific<Worker> workers;
-  std::vector<Chunk> chunks;
+  std::deque<Chunk> chunks;  // a deque: grown in place (a Chunk does not move)
   FclDetectorProfile profile;
   bool ready = false;
 
@@ -344,9 +345,9 @@ void FclDetector::detect(std::span<const RigidBody> bodies, const StepContext& c
   const std::size_t chunk_count = (s.pairs.size() + Impl::kPairsPerChunk - 1) / Impl::kPairsPerChunk;
   if (s.chunks.size() < chunk_count) s.chunks.resize(chunk_count);
   const auto run_chunks = [&](const tbb::blocked_range<std::size_t>& range) {
-    Impl::Worker& w = s.workers.local();
     for (std::size_t c = range.begin(); c != range.end(); ++c) {
       Impl::Chunk& out = s.chunks[c];
+      Impl::Worker& w = out.scratch;
       out.contacts.clear();
       out.calls = out.dropped = out.speculative = 0;
       const std::size_t end = std::min(s.pairs.size(), (c + 1) * Impl::kPairsPerChunk);
@@ -363,9 +364,9 @@ void FclDetector::detect(std::span<const RigidBody> bodies, const StepContext& c
     counters.contacts_dropped += out.dropped;
     counters.speculative_pairs += out.speculative;
   }
-  for (Impl::Worker& w : s.workers) {
-    s.profile.fcl_failures += w.fcl_failures;
-    w.fcl_failures = 0;
+  for (std::size_t c = 0; c < chunk_count; ++c) {
+    s.profile.fcl_failures += s.chunks[c].scratch.fcl_failures;
+    s.chunks[c].scratch.fcl_failures = 0;
   }
   counters.contacts += contacts.size();
   const auto end = Clock::now();

@@ -18,6 +18,8 @@
 
 #include <Eigen/Dense>
 
+#include <span>
+#include <utility>
 #include <vector>
 
 namespace impetus::ledas {
@@ -25,7 +27,10 @@ namespace impetus::ledas {
 class MaskedLdlt;
 
 /// The update's state against one factorization: the border columns computed so far and the last
-/// factorized Schur system. Belongs to one active-set loop; forget() whenever it refactors.
+/// factorized Schur system. Belongs to one active-set loop at a time; forget() whenever it refactors.
+/// Kept from solve to solve (ComplementarityWorkspace::update), it reuses its buffers: borders, Gram
+/// matrix and one Schur factorization per system size, so a loop that meets the sizes it met before
+/// allocates nothing.
 class BorderedUpdate {
  public:
   /// Forgets the borders and the last update (the factorization they were computed against changed).
@@ -46,22 +51,30 @@ class BorderedUpdate {
   // on first use, with its Gram entries against the borders already there.
   int border(const MaskedLdlt& factor, const std::vector<char>& in_base, const SparseMatrix& a, RowIndex row);
 
+  // y = S⁻¹ rhs by the last Schur factorization (full pivoting, full rank), without a temporary.
+  void solve_schur(std::span<const double> rhs, std::span<double> y);
+
   struct Border {  // one column of W = L⁻¹ P U, sparse
     std::vector<int> index;  // elimination order, increasing
     std::vector<double> value;
   };
-  std::vector<Border> borders_;
+  std::vector<Border> borders_;  // the first border_count_ are this factorization's; the rest keep storage
+  std::size_t border_count_ = 0;
   std::vector<int> border_of_;  // per row: its entry in borders_, or −1
-  Eigen::MatrixXd gram_;        // G_ij = w_iᵀ D⁻¹ w_j of the borders
+  Eigen::MatrixXd gram_;        // G_ij = w_iᵀ D⁻¹ w_j of the borders (i, j < border_count_; capacity grows)
   // The last update: the active set it solves for, its added and removed rows (their entries in
-  // borders_, added first) and the factorized Schur system.
+  // borders_, added first) and the factorized Schur system (schur_[size], one per size met).
   bool updated_ = false;
   std::vector<char> updated_for_;
   std::vector<RowIndex> added_, removed_;
   std::vector<int> slots_;
-  Eigen::FullPivLU<Eigen::MatrixXd> schur_;
+  std::vector<Eigen::MatrixXd> schur_matrix_;
+  std::vector<Eigen::FullPivLU<Eigen::MatrixXd>> schur_;
+  std::vector<std::pair<int, double>> column_;  // border()'s u
   Vector forward_;    // apply()'s t = L⁻¹ P c
   Vector scattered_;  // border()'s D⁻¹ w, zero between calls
+  Vector out_, residual_;            // solve()'s candidate and its check
+  std::vector<double> rhs_, y_, permuted_;  // apply()'s Schur right-hand side and solution; solve_schur's scratch
 };
 
 }  // namespace impetus::ledas

@@ -32,6 +32,11 @@ constexpr double kFactorizationWeight = 4.0;
 constexpr std::size_t kCacheCapacity = 16;
 }  // namespace
 
+ComplementarityWorkspace::ComplementarityWorkspace() = default;
+ComplementarityWorkspace::~ComplementarityWorkspace() = default;
+ComplementarityWorkspace::ComplementarityWorkspace(ComplementarityWorkspace&&) noexcept = default;
+ComplementarityWorkspace& ComplementarityWorkspace::operator=(ComplementarityWorkspace&&) noexcept = default;
+
 ComplementaritySolver::ComplementaritySolver(const SolverSettings& settings, EqualitySolver& equalities)
     : settings_(settings), equalities_(equalities) {}
 ComplementaritySolver::~ComplementaritySolver() = default;
@@ -73,7 +78,7 @@ void ComplementaritySolver::factorize_loop(ActiveLoop& loop, const SparseMatrix&
   ++stats.sparse;
   loop.factor->factorize(a, rows, settings_.rank_tolerance, loop.floor, shift);
   loop.factored = true;
-  loop.update.forget();
+  loop.update->forget();
   for (std::size_t k = 0; k < rows.size(); ++k) loop.in_base[k] = rows[k] && !loop.factor->dropped(k);
 }
 
@@ -94,7 +99,7 @@ void ComplementaritySolver::solve_active(const SparseMatrix& a, double shift, co
     const std::size_t limit = settings_.update_limit > 0
                                   ? settings_.update_limit
                                   : std::max<std::size_t>(8, static_cast<std::size_t>(std::sqrt(static_cast<double>(active.size()))));
-    if (changes <= limit && loop.update.solve(*loop.factor, loop.in_base, a, shift, r, active, settings_.rank_tolerance, z)) {
+    if (changes <= limit && loop.update->solve(*loop.factor, loop.in_base, a, shift, r, active, settings_.rank_tolerance, z)) {
       ++stats.updated;
       return;
     }
@@ -125,6 +130,9 @@ struct ComplementaritySolver::Search {
     loop.floor = settings.rank_tolerance * scale;
     loop.in_base.swap(work.in_base);
     loop.in_base.assign(free_rows.size(), 0);
+    if (!work.update) work.update = std::make_unique<BorderedUpdate>();
+    loop.update = work.update.get();
+    loop.update->forget();  // a new loop: nothing factorized yet
   }
   ~Search() { loop.in_base.swap(workspace.in_base); }
   Search(const Search&) = delete;
@@ -373,8 +381,8 @@ ComplementaritySolver::Refinement ComplementaritySolver::refine_on_free_set(cons
   Vector& direction = work_->direction;
   Vector& product = work_->product;
   restrict_to_solved(x);
-  residual.noalias() = -(a * x);
-  residual += c;
+  residual.noalias() = a * x;
+  residual = c - residual;  // c + (−A x), bit for bit
   restrict_to_solved(residual);
   precondition(loop, by_update, residual, preconditioned);
   direction = preconditioned;
@@ -433,7 +441,7 @@ bool ComplementaritySolver::prepare_preconditioner(const SparseMatrix& a, double
   bool holds = loop.factored;
   for (std::size_t k = 0; holds && k < free_rows.size(); ++k)
     holds = free_rows[k] ? (loop.in_base[k] || loop.factor->dropped(k)) : !loop.in_base[k];
-  const bool by_update = !holds && loop.factored && loop.update.solves_for(free_rows);
+  const bool by_update = !holds && loop.factored && loop.update->solves_for(free_rows);
   if (!holds && !by_update) factorize_loop(loop, a, free_rows, shift, stats);
   return by_update;
 }
@@ -441,7 +449,7 @@ bool ComplementaritySolver::prepare_preconditioner(const SparseMatrix& a, double
 // out = (A + εI)_FF⁻¹ v by the update or the factorization.
 void ComplementaritySolver::precondition(ActiveLoop& loop, bool by_update, const Vector& v, Vector& out) {
   if (by_update) {
-    loop.update.apply(*loop.factor, v, out);
+    loop.update->apply(*loop.factor, v, out);
   } else {
     out = v;
     loop.factor->solve(out);

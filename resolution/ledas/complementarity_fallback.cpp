@@ -145,20 +145,38 @@ void ComplementaritySolver::polish_minimum_norm(const SparseMatrix& a, const Vec
   members(rows, members_f);
   if (members_f.size() < 2 || members_f.size() > settings_.polish_limit) return;
   SolverStats ignored;
-  const SparseMatrix sub = principal_submatrix(a, members_f);
-  const Vector q = equalities_.solve_dense_matrix(Eigen::MatrixXd(sub), gather(c, members_f), ignored);
+  // A over the rows (dense: the polish is for small sets) and c over them, in the workspace.
+  const auto n = static_cast<Eigen::Index>(members_f.size());
+  std::vector<int>& position = work_->position;
+  position.assign(static_cast<std::size_t>(a.rows()), -1);
+  for (std::size_t i = 0; i < members_f.size(); ++i) position[members_f[i]] = static_cast<int>(i);
+  Eigen::MatrixXd& sub = work_->dense;
+  sub.setZero(n, n);
+  Vector& rhs = work_->gathered;
+  rhs.resize(n);
+  for (Eigen::Index j = 0; j < n; ++j) {
+    rhs(j) = c(members_f[static_cast<std::size_t>(j)]);
+    for (SparseMatrix::InnerIterator it(a, members_f[static_cast<std::size_t>(j)]); it; ++it)
+      if (const int i = position[static_cast<std::size_t>(it.row())]; i >= 0) sub(i, j) = it.value();
+  }
+  Vector& q = work_->solution;
+  equalities_.solve_dense_matrix(sub, rhs, ignored, work_->ldlt, q);
   const double roundoff = kImpulseRoundoff * q.lpNorm<Eigen::Infinity>();
   for (std::size_t i = 0; i < members_f.size(); ++i)
     if (!problem.equality[members_f[i]] && q(static_cast<Eigen::Index>(i)) < -roundoff) return;
   if (!q.allFinite()) return;
-  Vector candidate = p;
+  Vector& candidate = work_->candidate;
+  candidate = p;
   for (std::size_t i = 0; i < members_f.size(); ++i)
     candidate(members_f[i]) = problem.equality[members_f[i]] ? q(static_cast<Eigen::Index>(i))
                                                             : std::max(0.0, q(static_cast<Eigen::Index>(i)));
   // Same velocities to rounding, or keep the basic solution.
-  const Vector change = a * (candidate - p);
+  Vector& difference = work_->difference;
+  difference = candidate - p;
+  Vector& change = work_->change;
+  change.noalias() = a * difference;
   if (change.lpNorm<Eigen::Infinity>() > 0.5 * problem.tolerance) return;
-  p = std::move(candidate);
+  p.swap(candidate);
   ++stats.polished;
 }
 

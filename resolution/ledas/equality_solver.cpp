@@ -165,24 +165,35 @@ Vector EqualitySolver::solve_system(const SparseMatrix& m, const Vector& rhs, So
 }
 
 Vector EqualitySolver::solve_dense_matrix(const Eigen::MatrixXd& a, const Vector& rhs, SolverStats& stats) {
+  Eigen::LDLT<Eigen::MatrixXd> ldlt;
+  Vector p;
+  solve_dense_matrix(a, rhs, stats, ldlt, p);
+  return p;
+}
+
+void EqualitySolver::solve_dense_matrix(const Eigen::MatrixXd& a, const Vector& rhs, SolverStats& stats,
+                                        Eigen::LDLT<Eigen::MatrixXd>& ldlt, Vector& p) {
   ++stats.dense;
   const double scale = a.diagonal().maxCoeff();
   if (!(scale > 0.0) || !std::isfinite(scale)) {  // no movable body behind any row
     count_singular(!std::isfinite(scale) || rhs.lpNorm<Eigen::Infinity>() > 0.0, stats);
-    return Vector::Zero(a.rows());
+    p.setZero(a.rows());
+    return;
   }
   const double pivot_floor = settings_.rank_tolerance * scale;
   // LDLᵀ with diagonal pivoting reveals the rank of a PSD matrix: a dependent row leaves a ~0 pivot.
-  const Eigen::LDLT<Eigen::MatrixXd> ldlt(a);
-  if (ldlt.info() == Eigen::Success && (ldlt.vectorD().array() > pivot_floor).all()) return ldlt.solve(rhs);
+  ldlt.compute(a);
+  if (ldlt.info() == Eigen::Success && (ldlt.vectorD().array() > pivot_floor).all()) {
+    p = ldlt.solve(rhs);
+    return;
+  }
   // Minimum-norm least squares through the eigen-decomposition (the SVD of a symmetric PSD matrix).
   const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eigen(a);
   const Vector& lambda = eigen.eigenvalues();
   Vector y = eigen.eigenvectors().transpose() * rhs;
   for (Eigen::Index i = 0; i < y.size(); ++i) y(i) = lambda(i) > pivot_floor ? y(i) / lambda(i) : 0.0;
-  Vector p = eigen.eigenvectors() * y;
+  p = eigen.eigenvectors() * y;
   count_singular(!satisfies(a * p, rhs), stats);
-  return p;
 }
 
 namespace {

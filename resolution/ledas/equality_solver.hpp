@@ -31,6 +31,10 @@ class EqualitySolver {
   Vector solve_system(const SparseMatrix& m, const Vector& rhs, SolverStats& stats);
   /// Dense LDLᵀ with diagonal pivoting; minimum-norm least squares (eigen-decomposition) when singular.
   Vector solve_dense_matrix(const Eigen::MatrixXd& a, const Vector& rhs, SolverStats& stats);
+  /// The same into `p`, factorizing in `ldlt`: with both sized by an earlier call of the same size, the
+  /// regular case allocates nothing (the singular one does).
+  void solve_dense_matrix(const Eigen::MatrixXd& a, const Vector& rhs, SolverStats& stats,
+                          Eigen::LDLT<Eigen::MatrixXd>& ldlt, Vector& p);
 
  private:
   struct Factor;  // a sparse LDLᵀ with the pattern its analysis is for (equality_solve.cpp)

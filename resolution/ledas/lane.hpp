@@ -28,6 +28,7 @@ struct LedasResolver::Lane {
   std::vector<ledas::Island> islands;
   std::size_t islands_used = 0;  // this step's
   std::vector<ledas::RowIndex> kept;  // correct_positions' rows (all but tangent rows)
+  ledas::SparseMatrix restricted;     // and A over them
   ledas::Island& next_island() {
     if (islands_used == islands.size()) islands.emplace_back();
     return islands[islands_used++];

@@ -24,7 +24,7 @@ constexpr double kPositionTolerance = 1e-12;
 void LedasResolver::correct_positions(ledas::Island& island, std::span<RigidBody> bodies, Lane& lane) {
   std::vector<ledas::RowIndex>& kept = lane.kept;  // local rows of the correction problem (all but tangent rows)
   kept.clear();
-  ledas::SparseMatrix restricted;
+  ledas::SparseMatrix& restricted = lane.restricted;
   if (island.frictional) {
     for (std::size_t i = 0; i < island.rows.size(); ++i)
       if (island.role[i] != ledas::RowRole::tangent) kept.push_back(static_cast<ledas::RowIndex>(i));

@@ -27,7 +27,7 @@ struct ComplementaritySolver::ActiveLoop {
   bool singular = false;      // a factorization met a redundant row (pivot ≈ the shift)
   bool widened = false;       // the analysis was redone for rows beyond the start set
   std::vector<char> in_base;  // rows B of the last factorization (free and not dropped)
-  BorderedUpdate update;      // solves for active sets near B without refactoring
+  BorderedUpdate* update = nullptr;  // solves for active sets near B without refactoring (the workspace's)
 };
 
 /// v restricted to `rows`, in their order.

@@ -91,7 +91,14 @@ void add(SolverStats& into, const SolverStats& part);
 /// The buffers a complementarity solve works in. Eigen resizes a vector by reallocating it, so a caller
 /// that solves problems of one size again and again (an island, step after step) keeps one workspace
 /// per problem and hands it in (ComplementarityProblem::workspace): the solve then allocates nothing.
+class BorderedUpdate;
+
 struct ComplementarityWorkspace {
+  ComplementarityWorkspace();
+  ~ComplementarityWorkspace();
+  ComplementarityWorkspace(ComplementarityWorkspace&&) noexcept;
+  ComplementarityWorkspace& operator=(ComplementarityWorkspace&&) noexcept;
+
   Vector diagonal;                                  ///< A_kk
   Vector p, center, r, w, z;                        ///< the search's iterate, p̄, c + ε p̄, A z − c, subproblem solution
   Vector x;                                         ///< a refinement's iterate
@@ -99,7 +106,14 @@ struct ComplementarityWorkspace {
   Vector check;                                     ///< A p of the final check (IslandSolver)
   std::vector<char> free_rows, in_base, solved_rows;
   std::vector<Eigen::Index> unsolved_rows;
-  std::vector<RowIndex> members;                    ///< the polish's free rows
+  // The minimum-norm polish: its rows, A over them (dense) and its factorization, right-hand side and
+  // solution, the candidate impulses and their difference from the basic ones, and the row positions.
+  std::vector<RowIndex> members;
+  Eigen::MatrixXd dense;
+  Eigen::LDLT<Eigen::MatrixXd> ldlt;
+  Vector gathered, solution, candidate, difference, change;
+  std::vector<int> position;
+  std::unique_ptr<BorderedUpdate> update;           ///< the active-set loop's bordered update (private type)
 };
 
 struct ComplementarityProblem {

@@ -1,0 +1,85 @@
+// No allocation in the steady state: once a scene's contact pattern is stable, a whole step (detection,
+// resolution, integration) allocates nothing, for every thread count. Counted by the replaced global
+// operator new and C's malloc, calloc and realloc (benchmarks/support/allocation_counter.cpp, linked into
+// this program only); under AddressSanitizer the sanitizer owns malloc and the test is skipped.
+//
+// What is asserted is exact: zero allocations over kMeasuredSteps steps after kWarmSteps steps, with the
+// ledas resolver (complementary mode) on frictionless scenes. The frictional solver and the sequential
+// resolver still allocate per step (their counts are in bench_step's `allocations` counter), and are not
+// asserted here.
+
+#include "reliability_support.hpp"
+#include "support/allocation_counter.hpp"
+
+#include <cstdint>
+#include <string>
+
+namespace impetus::reliability {
+namespace {
+
+constexpr int kWarmSteps = 20;
+constexpr int kMeasuredSteps = 50;
+
+struct SteadyScene {
+  std::string name;
+  std::string yaml;
+};
+
+void PrintTo(const SteadyScene& s, std::ostream* out) { *out << s.name; }
+
+class SteadyState : public testing::TestWithParam<SteadyScene> {};
+
+// Allocations made by `steps` steps of `world`.
+std::uint64_t allocations_over(World& world, int steps) {
+  const std::uint64_t before = bench::allocations();
+  for (int i = 0; i < steps; ++i) world.step();
+  return bench::allocations() - before;
+}
+
+TEST_P(SteadyState, StepsAllocateNothing) {
+  if (!bench::counts_malloc()) GTEST_SKIP() << "sanitizer build: malloc is the sanitizer's, not counted";
+  const auto host = make_host();
+  for (const std::uint32_t threads : {1u, 2u}) {
+    SCOPED_TRACE("threads " + std::to_string(threads));
+    const std::unique_ptr<World> world =
+        build_world(load_scene_text(GetParam().yaml, "steady.yaml", scenes_dir(),
+                                    {{"threads", std::to_string(threads)}}),
+                    *host);
+    const std::uint64_t warm = allocations_over(*world, kWarmSteps);
+    EXPECT_GT(warm, 0u);  // the counter counts: the first steps size every buffer
+    const std::size_t contacts = world->contacts().size();
+    EXPECT_EQ(allocations_over(*world, kMeasuredSteps), 0u);
+    EXPECT_EQ(world->contacts().size(), contacts);  // the contact pattern was stable
+    EXPECT_GT(contacts, 0u);
+    EXPECT_EQ(world->last_status().resolver.non_converged, 0u);
+  }
+}
+
+const std::string kModules = "modules: {integrator: momentum, detector: fcl, resolver: {plugin: ledas, mode: complementary}}\n";
+
+INSTANTIATE_TEST_SUITE_P(
+    Frictionless, SteadyState,
+    testing::Values(
+        // One island: the pyramid of 55 spheres resting on the ground under gravity.
+        SteadyScene{"pyramid_10", kModules + "generators:\n  - pyramid: {rows: 10, radius: 0.5}\n"},
+        // A line of 100 spheres against a wall, the first moving in: the impact runs through the line.
+        SteadyScene{"line_100", kModules + "gravity: [0, 0, 0]\ngenerators:\n  - line: {count: 100, radius: 0.5}\n"},
+        // Many islands of different sizes: pyramids of 1 to 6 rows side by side on one ground.
+        SteadyScene{"islands", kModules + [] {
+                      std::string text = "bodies:\n  - {name: ground, fixed: true, shape: {plane: {normal: [0, 0, 1]}}}\n";
+                      double x = 0.0;
+                      for (int rows = 1; rows <= 6; ++rows) {
+                        for (int r = 0; r < rows; ++r)
+                          for (int i = 0; i < rows - r; ++i)
+                            text += "  - {name: p" + std::to_string(rows) + "_" + std::to_string(r) + "_" +
+                                    std::to_string(i) + ", shape: {sphere: {radius: 0.5}}, mass: 1, position: [" +
+                                    std::to_string(x + i + 0.5 * r) + ", 0, " +
+                                    std::to_string(0.4999 + r * 0.86593) + "]}\n";
+                        x += rows + 2.0;
+                      }
+                      return text;
+                    }()}),
+    [](const testing::TestParamInfo<SteadyScene>& info) { return info.param.name; });
+
+}  // namespace
+}  // namespace impetus::reliability
