@@ -58,6 +58,8 @@ struct Island {
   ComplementarityProblem impact, correction;
   ComplementarityWorkspace impact_work, correction_work;
   Vector impact_target, impact_solution, correction_solution;
+  std::vector<RowIndex> kept;  ///< a frictional island's correction rows (all but tangent rows)
+  SparseMatrix restricted;     ///< and A over them
 
   /// Sets `complementarity` = max over contact normal rows of |Σ p · (v_n − target)| at velocities v (after
   /// an inelastic phase).

@@ -27,8 +27,7 @@ struct LedasResolver::Lane {
   // that a stable contact pattern is solved in buffers of the right sizes, without allocating.
   std::vector<ledas::Island> islands;
   std::size_t islands_used = 0;  // this step's
-  std::vector<ledas::RowIndex> kept;  // correct_positions' rows (all but tangent rows)
-  ledas::SparseMatrix restricted;     // and A over them
+  std::vector<int> position;  // correct_positions' scratch
   ledas::Island& next_island() {
     if (islands_used == islands.size()) islands.emplace_back();
     return islands[islands_used++];

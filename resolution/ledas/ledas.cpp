@@ -111,18 +111,20 @@ void LedasResolver::resolve(std::span<RigidBody> bodies, std::span<Contact> cont
 void LedasResolver::bodies_removed(std::span<const std::int64_t> new_index) noexcept {
   // Renumbering keeps a < b (removal preserves order), so the map's order is unchanged.
   const auto renumbered = [&](BodyIndex i) { return i < new_index.size() ? new_index[i] : std::int64_t{-1}; };
-  try {
-    std::map<ContactKey, ContactImpulse> kept;
-    for (const auto& [key, impulse] : next_warm_) {
-      const std::int64_t a = renumbered(key.a), b = renumbered(key.b);
-      if (a >= 0 && b >= 0)
-        kept.emplace_hint(kept.end(), ContactKey{static_cast<BodyIndex>(a), static_cast<BodyIndex>(b), key.feature},
-                          impulse);
-    }
-    next_warm_.swap(kept);
-  } catch (const std::bad_alloc&) {
-    next_warm_.clear();  // a cold start next step: slower, never wrong
+  std::size_t kept = 0;  // in place: renumbering keeps the order, so the list stays sorted
+  for (const WarmStart& w : next_warm_) {
+    const std::int64_t a = renumbered(w.key.a), b = renumbered(w.key.b);
+    if (a >= 0 && b >= 0)
+      next_warm_[kept++] = {ContactKey{static_cast<BodyIndex>(a), static_cast<BodyIndex>(b), w.key.feature}, w.impulse,
+                            w.order};
   }
+  next_warm_.resize(kept);
+}
+
+const LedasResolver::ContactImpulse* LedasResolver::find_warm(const ContactKey& key) const {
+  const auto it = std::lower_bound(warm_.begin(), warm_.end(), key,
+                                   [](const WarmStart& entry, const ContactKey& k) { return entry.key < k; });
+  return it != warm_.end() && it->key == key ? &it->impulse : nullptr;
 }
 
 void LedasResolver::resolve_all(std::span<RigidBody> bodies, std::span<Contact> contacts,
@@ -157,8 +159,16 @@ void LedasResolver::resolve_all(std::span<RigidBody> bodies, std::span<Contact> 
     const Lane& l = *lanes_[k];
     add(stats_, l.stats);
     add(counters, l.counters);
-    for (const auto& [key, impulse] : l.remembered) next_warm_.insert_or_assign(key, impulse);
+    for (const auto& [key, impulse] : l.remembered) next_warm_.push_back({key, impulse, next_warm_.size()});
   }
+  // Sorted by key, then order (std::sort, not stable_sort, which would allocate its buffer); of equal keys
+  // (two contacts with one feature key) the last remembered is kept.
+  std::sort(next_warm_.begin(), next_warm_.end(), [](const WarmStart& x, const WarmStart& y) {
+    return x.key < y.key || (x.key == y.key && x.order < y.order);
+  });
+  const auto last_of_each = std::unique(next_warm_.rbegin(), next_warm_.rend(),
+                                        [](const WarmStart& x, const WarmStart& y) { return x.key == y.key; });
+  next_warm_.erase(next_warm_.begin(), last_of_each.base());
 }
 
 // The rows of this step: one per valid contact (eq. 5's direction, eq. 7's arms) and, in complementary
@@ -179,9 +189,9 @@ void LedasResolver::build_rows(std::span<const RigidBody> bodies, std::span<Cont
       continue;
     }
     rows_.push_back(resolution::make_contact_row(bodies, inertia_, c));
-    const auto warm = warm_.find(ContactKey{c.a, c.b, c.feature});
-    const bool warmed = warm != warm_.end() && settings_.warm_start;
-    row_warm_.push_back(warmed ? warm->second.normal : 0.0);
+    const ContactImpulse* warm = settings_.warm_start ? find_warm(ContactKey{c.a, c.b, c.feature}) : nullptr;
+    const bool warmed = warm != nullptr;
+    row_warm_.push_back(warmed ? warm->normal : 0.0);
     ledas::RowInfo ri;
     ri.depth = c.depth;
     ri.contact = static_cast<std::int64_t>(k);
@@ -192,7 +202,7 @@ void LedasResolver::build_rows(std::span<const RigidBody> bodies, std::span<Cont
       tangent_basis(c.normal, t[0], t[1]);
       for (std::uint8_t j = 0; j < 2; ++j) {
         rows_.push_back(resolution::make_row(bodies, inertia_, c.a, c.b, c.point, t[j]));
-        row_warm_.push_back(warmed ? warm->second.tangent.dot(t[j]) : 0.0);
+        row_warm_.push_back(warmed ? warm->tangent.dot(t[j]) : 0.0);
         ri.tangent = static_cast<std::uint8_t>(j + 1);
         info_.push_back(ri);
       }

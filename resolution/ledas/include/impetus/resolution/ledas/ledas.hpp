@@ -173,7 +173,15 @@ class LedasResolver final : public CollisionResolver {
     double normal = 0.0;
     Vec3 tangent = Vec3::Zero();
   };
-  std::map<ContactKey, ContactImpulse> warm_, next_warm_;
+  // Sorted by key, unique (a flat map: swapped and refilled step after step without allocating); `order`
+  // is the entry's place in the lanes' lists, so that of two contacts with one key the last is kept.
+  struct WarmStart {
+    ContactKey key;
+    ContactImpulse impulse;
+    std::size_t order = 0;
+  };
+  std::vector<WarmStart> warm_, next_warm_;
+  const ContactImpulse* find_warm(const ContactKey& key) const;
   std::vector<double> row_warm_;
 };
 
