@@ -33,18 +33,35 @@ std::uint64_t work_budget(std::size_t rows, const SolverSettings& settings) {
 }
 
 SparseMatrix principal_submatrix(const SparseMatrix& a, std::span<const RowIndex> subset) {
-  std::vector<int> position(static_cast<std::size_t>(a.rows()), -1);
-  for (std::size_t i = 0; i < subset.size(); ++i) position[subset[i]] = static_cast<int>(i);
-  std::vector<Eigen::Triplet<double>> entries;
-  for (std::size_t j = 0; j < subset.size(); ++j)
-    for (SparseMatrix::InnerIterator it(a, subset[j]); it; ++it)
-      if (const int i = position[static_cast<std::size_t>(it.row())]; i >= 0)
-        entries.emplace_back(i, static_cast<int>(j), it.value());
-  const auto n = static_cast<Eigen::Index>(subset.size());
-  SparseMatrix out(n, n);
-  out.setFromTriplets(entries.begin(), entries.end());
-  out.makeCompressed();
+  SparseMatrix out;
+  std::vector<int> position;
+  principal_submatrix(a, subset, out, position);
   return out;
+}
+
+// Written in compressed form directly: column j is column subset[j] of `a` without the rows outside the
+// subset, in increasing order because the subset is.
+void principal_submatrix(const SparseMatrix& a, std::span<const RowIndex> subset, SparseMatrix& out,
+                         std::vector<int>& position) {
+  position.assign(static_cast<std::size_t>(a.rows()), -1);
+  for (std::size_t i = 0; i < subset.size(); ++i) position[subset[i]] = static_cast<int>(i);
+  const auto n = static_cast<Eigen::Index>(subset.size());
+  out.resize(n, n);
+  std::size_t nonzeros = 0;
+  for (const RowIndex k : subset) nonzeros += static_cast<std::size_t>(a.outerIndexPtr()[k + 1] - a.outerIndexPtr()[k]);
+  out.resizeNonZeros(static_cast<Eigen::Index>(nonzeros));
+  int q = 0;
+  for (Eigen::Index j = 0; j < n; ++j) {
+    out.outerIndexPtr()[j] = q;
+    for (SparseMatrix::InnerIterator it(a, subset[static_cast<std::size_t>(j)]); it; ++it)
+      if (const int i = position[static_cast<std::size_t>(it.row())]; i >= 0) {
+        out.innerIndexPtr()[q] = i;
+        out.valuePtr()[q] = it.value();
+        ++q;
+      }
+  }
+  out.outerIndexPtr()[n] = q;
+  out.resizeNonZeros(q);
 }
 
 Vector IslandSolver::solve_subset(const SparseMatrix& a, const Vector& c, std::span<const RowIndex> subset,

@@ -27,7 +27,7 @@ struct LedasResolver::Lane {
   // that a stable contact pattern is solved in buffers of the right sizes, without allocating.
   std::vector<ledas::Island> islands;
   std::size_t islands_used = 0;  // this step's
-  std::vector<int> position;  // correct_positions' scratch
+  std::vector<int> position;  // correct_positions' scratch (principal_submatrix)
   ledas::Island& next_island() {
     if (islands_used == islands.size()) islands.emplace_back();
     return islands[islands_used++];

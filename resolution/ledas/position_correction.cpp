@@ -15,31 +15,6 @@ namespace impetus {
 namespace {
 // Position-correction problems are in metres; a violation below this is rounding.
 constexpr double kPositionTolerance = 1e-12;
-
-// A over the rows `kept` (increasing) into `out`, its storage reused; `position` is scratch. The same
-// entries as ledas::principal_submatrix, written in compressed form directly.
-void restrict_matrix(const ledas::SparseMatrix& a, std::span<const ledas::RowIndex> kept, ledas::SparseMatrix& out,
-                     std::vector<int>& position) {
-  position.assign(static_cast<std::size_t>(a.rows()), -1);
-  for (std::size_t i = 0; i < kept.size(); ++i) position[kept[i]] = static_cast<int>(i);
-  const auto n = static_cast<Eigen::Index>(kept.size());
-  out.resize(n, n);
-  std::size_t nonzeros = 0;
-  for (const ledas::RowIndex k : kept) nonzeros += static_cast<std::size_t>(a.outerIndexPtr()[k + 1] - a.outerIndexPtr()[k]);
-  out.resizeNonZeros(static_cast<Eigen::Index>(nonzeros));
-  int q = 0;
-  for (Eigen::Index j = 0; j < n; ++j) {
-    out.outerIndexPtr()[j] = q;
-    for (ledas::SparseMatrix::InnerIterator it(a, kept[static_cast<std::size_t>(j)]); it; ++it)
-      if (const int i = position[static_cast<std::size_t>(it.row())]; i >= 0) {
-        out.innerIndexPtr()[q] = i;
-        out.valuePtr()[q] = it.value();
-        ++q;
-      }
-  }
-  out.outerIndexPtr()[n] = q;
-  out.resizeNonZeros(q);
-}
 }  // namespace
 
 // The same complementarity problem as the complementary mode's impact, with the correction targets as
@@ -53,7 +28,7 @@ void LedasResolver::correct_positions(ledas::Island& island, std::span<RigidBody
   if (island.frictional) {
     for (std::size_t i = 0; i < island.rows.size(); ++i)
       if (island.role[i] != ledas::RowRole::tangent) kept.push_back(static_cast<ledas::RowIndex>(i));
-    restrict_matrix(island.a, kept, restricted, lane.position);
+    ledas::principal_submatrix(island.a, kept, restricted, lane.position);
   }
   const auto local = [&](std::size_t j) { return island.frictional ? kept[j] : j; };
   const std::size_t m = island.frictional ? kept.size() : island.rows.size();

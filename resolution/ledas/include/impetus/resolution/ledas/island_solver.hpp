@@ -179,5 +179,8 @@ std::uint64_t work_budget(std::size_t rows, const SolverSettings& settings);
 
 /// The principal submatrix A_SS of `a` for the rows `subset` (increasing).
 SparseMatrix principal_submatrix(const SparseMatrix& a, std::span<const RowIndex> subset);
+/// The same into `out`, its storage reused; `position` is scratch.
+void principal_submatrix(const SparseMatrix& a, std::span<const RowIndex> subset, SparseMatrix& out,
+                         std::vector<int>& position);
 
 }  // namespace impetus::ledas
