@@ -21,11 +21,13 @@ constexpr std::uint64_t kJointRounds = 16;
 
 using ledas::Vector;
 
-// The last step's impulses of the island's rows (0 where a contact is new).
-Vector LedasResolver::warm_start(const ledas::Island& island) const {
-  Vector r(static_cast<Eigen::Index>(island.rows.size()));
+// Sets island.friction_start to the last step's impulses of the island's rows (0 where a contact is new);
+// returns whether any is not 0.
+bool LedasResolver::warm_start(ledas::Island& island) const {
+  Vector& r = island.friction_start;
+  r.resize(static_cast<Eigen::Index>(island.rows.size()));
   for (std::size_t i = 0; i < island.rows.size(); ++i) r(static_cast<Eigen::Index>(i)) = row_warm_[island.rows[i]];
-  return r;
+  return r.any();
 }
 
 // Keeps the island's frictional contacts' inelastic impulses for the next step's warm start.
@@ -43,17 +45,21 @@ void LedasResolver::remember_impulses(Lane& lane, const ledas::Island& island, s
 }
 
 // Solves the island's frictional problem u = A r + q (A = W over the island's rows, q = v − target),
-// tried first from `start` if given.
-Vector LedasResolver::solve_frictional(Lane& lane, ledas::Island& island, const Vector& q, const Vector* start) {
-  ledas::FrictionalProblem problem;
-  problem.start = start;
+// tried first from island.friction_start if `warm`, into island.friction_impulse (returned). The problem
+// is rebuilt in the island's buffers: no allocation when the island's size did not change.
+Vector& LedasResolver::solve_frictional(Lane& lane, ledas::Island& island, const Vector& v, const Vector& target,
+                                        bool warm) {
+  ledas::FrictionalProblem& problem = island.friction;
+  problem.start = warm ? &island.friction_start : nullptr;
   problem.w = &island.a;
-  problem.q = q;
+  problem.q = v - target;
   problem.role = island.role;
   problem.mu = island.mu;
   problem.dofs = 6 * island.bodies.size();
-  problem.tolerance = std::max(kFrictionalRelativeTolerance * q.norm(), kFrictionalAbsoluteTolerance);
-  return lane.friction.solve(problem, lane.stats.friction);
+  problem.tolerance = std::max(kFrictionalRelativeTolerance * problem.q.norm(), kFrictionalAbsoluteTolerance);
+  problem.workspace = &island.friction_work;
+  lane.friction.solve(problem, lane.stats.friction, island.friction_impulse);
+  return island.friction_impulse;
 }
 
 // Applies the impulses p on the island's rows (eq. 3 per row, tangent rows along t1, t2) and adds the
@@ -61,7 +67,7 @@ Vector LedasResolver::solve_frictional(Lane& lane, ledas::Island& island, const 
 // pᵀ(v⁻ + v⁺)/2 row by row).
 void LedasResolver::apply_island_impulse(ledas::Island& island, const Vector& p, std::span<RigidBody> bodies,
                                          Lane& lane) {
-  const Vector before = current_velocities(island, bodies);
+  const Vector& before = island.velocity_before = current_velocities(island, bodies);
   for (std::size_t i = 0; i < island.rows.size(); ++i)
     if (const double pi = p(static_cast<Eigen::Index>(i)); pi != 0.0)
       resolution::apply_row_impulse(rows_[island.rows[i]], pi, bodies);
@@ -84,7 +90,7 @@ void LedasResolver::apply_island_impulse(ledas::Island& island, const Vector& p,
 // value (ΔE is quadratic in α), so no impact creates energy for any e ≤ 1.
 void LedasResolver::velocity_frictional(ledas::Island& island, std::span<RigidBody> bodies, Lane& lane) {
   const std::size_t m = island.rows.size();
-  const Vector v0 = current_velocities(island, bodies);
+  const Vector& v0 = island.velocity_start = current_velocities(island, bodies);
   const double energy0 = ledas::kinetic_energy(bodies, island.bodies);
   bool needed = false;
   for (std::size_t i = 0; i < m; ++i) {
@@ -101,12 +107,13 @@ void LedasResolver::velocity_frictional(ledas::Island& island, std::span<RigidBo
     if (round > 0 && !refine) break;
     if (round == 0 && !needed && !refine) return;
     const std::uint64_t failures = lane.stats.friction.non_converged;
-    const Vector warm = round == 0 && settings_.warm_start ? warm_start(island) : Vector();
-    Vector r = solve_frictional(lane, island, v - island.target, warm.size() > 0 && warm.any() ? &warm : nullptr);
+    const bool warm = round == 0 && settings_.warm_start && warm_start(island);
+    Vector& r = solve_frictional(lane, island, v, island.target, warm);
     // A problem left unsolved (counted) still must not create energy: its best iterate is scaled back
     // so that ΔE = rᵀv + ½ rᵀA r ≤ 0 (rows' velocities v before it).
     if (lane.stats.friction.non_converged != failures) {
-      const double linear = r.dot(v), quadratic = 0.5 * r.dot(island.a * r);
+      island.product.noalias() = island.a * r;
+      const double linear = r.dot(v), quadratic = 0.5 * r.dot(island.product);
       if (linear + quadratic > 0.0) r *= linear < 0.0 && quadratic > 0.0 ? std::min(1.0, -linear / quadratic) : 0.0;
     }
     for (std::size_t i = 0; i < m; ++i)
@@ -115,12 +122,12 @@ void LedasResolver::velocity_frictional(ledas::Island& island, std::span<RigidBo
     apply_island_impulse(island, r, bodies, lane);
     ++island.rounds;
   }
-  const Vector v1 = current_velocities(island, bodies);
+  const Vector& v1 = island.velocity_inelastic = current_velocities(island, bodies);
   island.measure_complementarity(v1, island.target);
   if (!island.bouncing()) return;
 
   // Phase 2: normal targets e |v_n⁻| where the contact bounces, the step's targets elsewhere.
-  Vector target = island.target;
+  Vector& target = island.bounce_target = island.target;
   bool bounce = false;
   for (std::size_t i = 0; i < m; ++i) {
     const auto ei = static_cast<Eigen::Index>(i);
@@ -129,9 +136,10 @@ void LedasResolver::velocity_frictional(ledas::Island& island, std::span<RigidBo
     bounce = bounce || v1(ei) < target(ei) - settings_.tolerance;
   }
   if (!bounce) return;
-  Vector r = solve_frictional(lane, island, v1 - target);
+  Vector& r = solve_frictional(lane, island, v1, target, false);
   // ΔE(α) = α rᵀv₁ + ½ α² rᵀ A r; the budget is what phase 1 dissipated.
-  const double linear = r.dot(v1), quadratic = 0.5 * r.dot(island.a * r);
+  island.product.noalias() = island.a * r;
+  const double linear = r.dot(v1), quadratic = 0.5 * r.dot(island.product);
   const double budget = std::max(0.0, energy0 - ledas::kinetic_energy(bodies, island.bodies));
   if (linear + quadratic > budget + 0.5 * ledas::kRoundoff * energy0) {  // beyond rounding
     const double alpha = quadratic > 0.0

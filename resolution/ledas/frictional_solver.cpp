@@ -52,6 +52,25 @@ struct Linearization {
   double ratio = 0.0;             // slide: c = μ z_n / ‖z_t‖ (< 1); surface: μ s / ‖z_t‖
 };
 
+}  // namespace
+
+// Newton's buffers (sized on first use, reused while the problem's size does not change).
+struct FrictionalWorkspace::Newton {
+  std::vector<Block> blocks;
+  Vector diagonal;
+  Vector best, u, f, trial, u_trial, f_trial, d;
+  std::vector<Linearization> lin, lin_trial;
+  Eigen::MatrixXd jacobian;  // the dense path's
+  Eigen::PartialPivLU<Eigen::MatrixXd> lu;
+};
+
+FrictionalWorkspace::FrictionalWorkspace() = default;
+FrictionalWorkspace::~FrictionalWorkspace() = default;
+FrictionalWorkspace::FrictionalWorkspace(FrictionalWorkspace&&) noexcept = default;
+FrictionalWorkspace& FrictionalWorkspace::operator=(FrictionalWorkspace&&) noexcept = default;
+
+namespace {
+
 // The largest eigenvalue of the symmetric 3 × 3 block of W at rows first .. first + 2.
 double block_largest_eigenvalue(const SparseMatrix& w, Eigen::Index first) {
   Eigen::Matrix3d block = Eigen::Matrix3d::Zero();
@@ -61,11 +80,12 @@ double block_largest_eigenvalue(const SparseMatrix& w, Eigen::Index first) {
   return Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(block, Eigen::EigenvaluesOnly).eigenvalues().maxCoeff();
 }
 
-std::vector<Block> make_blocks(const FrictionalProblem& problem, const Vector& diagonal) {
+// The problem's blocks into `blocks` (its storage reused), with W's diagonal `diagonal`.
+void make_blocks(const FrictionalProblem& problem, const Vector& diagonal, std::vector<Block>& blocks) {
   const auto m = problem.q.size();
   if (problem.role.size() != static_cast<std::size_t>(m) || problem.mu.size() != static_cast<std::size_t>(m))
     throw std::invalid_argument("frictional problem: role and mu must have one entry per row");
-  std::vector<Block> blocks;
+  blocks.clear();
   for (Eigen::Index i = 0; i < m;) {
     Block b;
     b.first = i;
@@ -91,6 +111,11 @@ std::vector<Block> make_blocks(const FrictionalProblem& problem, const Vector& d
     blocks.push_back(b);
     i += b.size;
   }
+}
+
+std::vector<Block> make_blocks(const FrictionalProblem& problem, const Vector& diagonal) {
+  std::vector<Block> blocks;
+  make_blocks(problem, diagonal, blocks);
   return blocks;
 }
 
@@ -218,15 +243,21 @@ void assemble_jacobian(const std::vector<Block>& blocks, const std::vector<Linea
   }
 }
 
-// The Newton direction: J d = −F. Empty if the system could not be solved to finite values.
-Vector newton_direction(const std::vector<Block>& blocks, const std::vector<Linearization>& lin,
-                        const SparseMatrix& w, double shift, const Vector& f, std::size_t dense_limit) {
+// The Newton direction: J d = −F, into d (the dense path in `buffers`, without allocating when the
+// size did not change). False if the system could not be solved to finite values.
+bool newton_direction(const std::vector<Block>& blocks, const std::vector<Linearization>& lin, const SparseMatrix& w,
+                      double shift, const Vector& f, std::size_t dense_limit, FrictionalWorkspace::Newton& buffers,
+                      Vector& d) {
   const Eigen::Index m = f.size();
-  Vector d;
   if (static_cast<std::size_t>(m) <= dense_limit) {
-    Eigen::MatrixXd j = Eigen::MatrixXd::Zero(m, m);
+    Eigen::MatrixXd& j = buffers.jacobian;
+    j.setZero(m, m);
     assemble_jacobian(blocks, lin, w, shift, [&j](Eigen::Index r, Eigen::Index c, double v) { j(r, c) += v; });
-    d = Eigen::PartialPivLU<Eigen::MatrixXd>(j).solve(-f);
+    buffers.lu.compute(j);
+    // J d = −F solved as −(J⁻¹ F): the same bits (every operation of the solve is odd in its right-hand
+    // side), without a temporary for −F.
+    d.noalias() = buffers.lu.solve(f);
+    d = -d;
   } else {
     std::vector<Eigen::Triplet<double>> entries;
     entries.reserve(static_cast<std::size_t>(w.nonZeros()) * 2 + static_cast<std::size_t>(m) * 4);
@@ -236,11 +267,11 @@ Vector newton_direction(const std::vector<Block>& blocks, const std::vector<Line
     j.setFromTriplets(entries.begin(), entries.end());
     Eigen::SparseLU<SparseMatrix, Eigen::COLAMDOrdering<int>> lu;
     lu.compute(j);
-    if (lu.info() != Eigen::Success) return {};
+    if (lu.info() != Eigen::Success) return false;
     d = lu.solve(-f);
-    if (lu.info() != Eigen::Success) return {};
+    if (lu.info() != Eigen::Success) return false;
   }
-  return d.allFinite() ? d : Vector();
+  return d.allFinite();
 }
 
 // One projected Gauss–Seidel sweep over the blocks, each block's u from the current r.
@@ -322,8 +353,12 @@ void project_on_cone(double mu, double& yn, double& yt1, double& yt2) {
   yt2 *= scale;
 }
 
-double natural_map_residual(const FrictionalProblem& problem, const Vector& r) {
-  const Vector u = *problem.w * r + problem.q;
+namespace {
+
+// natural_map_residual with u = W r + q computed into `u`.
+double natural_map_residual_in(const FrictionalProblem& problem, const Vector& r, Vector& u) {
+  u.noalias() = *problem.w * r;
+  u += problem.q;
   double sum = 0.0;
   const auto m = r.size();
   for (Eigen::Index i = 0; i < m;) {
@@ -352,6 +387,14 @@ double natural_map_residual(const FrictionalProblem& problem, const Vector& r) {
   return std::sqrt(sum);
 }
 
+}  // namespace
+
+double natural_map_residual(const FrictionalProblem& problem, const Vector& r) {
+  if (problem.workspace != nullptr) return natural_map_residual_in(problem, r, problem.workspace->u);
+  Vector u;
+  return natural_map_residual_in(problem, r, u);
+}
+
 // Newton's method on `problem` from r (which it overwrites with the best iterate it met, by the
 // natural-map residual of `problem`); at most `iterations` steps. Returns that residual.
 double FrictionalSolver::newton(const FrictionalProblem& problem, const std::vector<Block>& blocks, Vector& r,
@@ -359,17 +402,24 @@ double FrictionalSolver::newton(const FrictionalProblem& problem, const std::vec
   const SparseMatrix& w = *problem.w;
   const Eigen::Index m = problem.q.size();
   const double shift = m > 0 ? settings_.regularization * w.diagonal().maxCoeff() : 0.0;
-  Vector best = r;
+  FrictionalWorkspace::Newton& buffers = *buffers_;
+  Vector &best = buffers.best, &u = buffers.u, &f = buffers.f, &trial = buffers.trial, &u_trial = buffers.u_trial,
+         &f_trial = buffers.f_trial, &d = buffers.d;
+  std::vector<Linearization>&lin = buffers.lin, &lin_trial = buffers.lin_trial;
+  best = r;
   double best_residual = natural_map_residual(problem, r);
-  Vector u = w * r + problem.q, f(m), trial(m), u_trial(m), f_trial(m);
-  std::vector<Linearization> lin, lin_trial;
+  u.noalias() = w * r;
+  u += problem.q;
+  f.resize(m);
+  trial.resize(m);
+  u_trial.resize(m);
+  f_trial.resize(m);
   evaluate(blocks, r, u, f, lin);
   double merit = 0.5 * f.squaredNorm();
   for (std::uint64_t it = 0; it < iterations && best_residual > problem.tolerance && steps_left_ > 0; ++it) {
     ++stats.newton_steps;
     --steps_left_;
-    const Vector d = newton_direction(blocks, lin, w, shift, f, settings_.dense_limit);
-    if (d.size() == 0) {
+    if (!newton_direction(blocks, lin, w, shift, f, settings_.dense_limit, buffers, d)) {
       ++stats.nan_caught;
       break;
     }
@@ -378,7 +428,8 @@ double FrictionalSolver::newton(const FrictionalProblem& problem, const std::vec
     bool accepted = false;
     for (; step >= kShortestStep; step *= 0.5) {
       trial = r + step * d;
-      u_trial = w * trial + problem.q;
+      u_trial.noalias() = w * trial;
+      u_trial += problem.q;
       evaluate(blocks, trial, u_trial, f_trial, lin_trial);
       trial_merit = 0.5 * f_trial.squaredNorm();
       if (trial_merit <= (1.0 - 2.0 * kArmijo * step) * merit) {
@@ -442,10 +493,20 @@ Vector FrictionalSolver::proximal_newton(const FrictionalProblem& problem, const
 }
 
 Vector FrictionalSolver::solve(const FrictionalProblem& problem, FrictionalStats& stats) {
+  Vector r;
+  solve(problem, stats, r);
+  return r;
+}
+
+void FrictionalSolver::solve(const FrictionalProblem& problem, FrictionalStats& stats, Vector& r) {
+  FrictionalWorkspace own;  // without the problem's workspace (sized here, freed on return)
+  FrictionalWorkspace& workspace = problem.workspace != nullptr ? *problem.workspace : own;
+  if (!workspace.newton) workspace.newton = std::make_unique<FrictionalWorkspace::Newton>();
+  buffers_ = workspace.newton.get();
   const Eigen::Index m = problem.q.size();
   ++stats.problems;
   const bool warm = problem.start != nullptr && problem.start->size() == m && problem.start->allFinite();
-  Vector r = Vector::Zero(m);
+  r.setZero(m);
   double residual = 0.0;
   if (warm && !problem.convex) {
     // 0. The warm start (e.g. the last step's impulses): a resting body's usually solve the problem as
@@ -455,12 +516,14 @@ Vector FrictionalSolver::solve(const FrictionalProblem& problem, FrictionalStats
     residual = natural_map_residual(problem, r);
     if (residual > problem.tolerance && settings_.warm_newton_iterations > 0) {
       steps_left_ = settings_.warm_newton_iterations;
-      residual = newton(problem, make_blocks(problem, problem.w->diagonal()), r, settings_.warm_newton_iterations, stats);
+      buffers_->diagonal = problem.w->diagonal();
+      make_blocks(problem, buffers_->diagonal, buffers_->blocks);
+      residual = newton(problem, buffers_->blocks, r, settings_.warm_newton_iterations, stats);
     }
     if (residual <= problem.tolerance) {
       ++stats.warm_started;
       stats.residual = std::max(stats.residual, residual);
-      return r;
+      return;
     }
     r.setZero();
   }
@@ -524,7 +587,6 @@ Vector FrictionalSolver::solve(const FrictionalProblem& problem, FrictionalStats
   }
   if (residual > problem.tolerance) ++stats.non_converged;
   stats.residual = std::max(stats.residual, residual);
-  return r;
 }
 
 // The stages (file comment) on `problem` from r, which they overwrite with the best iterate met; returns

@@ -61,6 +61,16 @@ struct Island {
   std::vector<RowIndex> kept;  ///< a frictional island's correction rows (all but tangent rows)
   SparseMatrix restricted;     ///< and A over them
 
+  /// A frictional island's impact (frictional_impact.cpp), in buffers kept the same way: the problem
+  /// (role, μ and q copied into it), the solve's workspace, the warm start and a phase's impulse, the
+  /// rows' velocities before the impact (v₀), after its inelastic phase (v₁) and before an impulse is
+  /// applied, the restitution phase's targets, and A r.
+  FrictionalProblem friction;
+  FrictionalWorkspace friction_work;
+  Vector friction_start, friction_impulse;
+  Vector velocity_start, velocity_inelastic, velocity_before;
+  Vector bounce_target, product;
+
   /// Sets `complementarity` = max over contact normal rows of |Σ p · (v_n − target)| at velocities v (after
   /// an inelastic phase).
   void measure_complementarity(const Vector& v, const Vector& target_now);

@@ -10,7 +10,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <new>
 #include <span>
 #include <string>
 #include <utility>

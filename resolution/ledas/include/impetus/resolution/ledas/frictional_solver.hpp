@@ -37,6 +37,7 @@
 #include "impetus/resolution/ledas/island_solver.hpp"
 
 #include <cstdint>
+#include <memory>
 #include <vector>
 
 namespace impetus::ledas {
@@ -46,6 +47,20 @@ enum class RowRole : std::uint8_t {
   equality,  ///< a joint row: u = 0, r free
   normal,    ///< a contact's normal row; with μ > 0 its two tangent rows follow it
   tangent    ///< one of the two tangent rows after a frictional normal row
+};
+
+/// Buffers a solve works in. A caller that solves problems of one size again and again (an island, step
+/// after step) keeps one per problem and hands it in (FrictionalProblem::workspace): a problem its warm
+/// start solves then allocates nothing.
+struct FrictionalWorkspace {
+  FrictionalWorkspace();
+  ~FrictionalWorkspace();
+  FrictionalWorkspace(FrictionalWorkspace&&) noexcept;
+  FrictionalWorkspace& operator=(FrictionalWorkspace&&) noexcept;
+
+  Vector u;  ///< u = W r + q of the natural-map residual
+  struct Newton;  ///< the Newton steps' buffers (frictional_solver.cpp)
+  std::unique_ptr<Newton> newton;
 };
 
 /// One island's frictional contact problem.
@@ -65,6 +80,7 @@ struct FrictionalProblem {
   /// K* = {u_n ≥ μ‖u_t‖}; a slipping contact separates at μ‖u_t‖). Its velocities are unique, and a
   /// static equilibrium (u = 0 with r in the cones), when one exists, is its answer.
   bool convex = false;
+  FrictionalWorkspace* workspace = nullptr;  ///< buffers to solve in (null: the solve's own)
 };
 
 /// How frictional problems are solved (configuration).
@@ -125,6 +141,9 @@ class FrictionalSolver {
   /// Returns r (m): the iterate with the smallest natural-map residual, which is ≤ problem.tolerance
   /// unless counted in stats.non_converged.
   Vector solve(const FrictionalProblem& problem, FrictionalStats& stats);
+  /// The same into `r` (its storage reused: with the problem's workspace, a problem its warm start solves
+  /// is solved without allocating).
+  void solve(const FrictionalProblem& problem, FrictionalStats& stats, Vector& r);
 
   const FrictionalSettings& settings() const { return settings_; }
 
@@ -139,6 +158,7 @@ class FrictionalSolver {
 
   FrictionalSettings settings_;
   std::uint64_t steps_left_ = 0;  // Newton steps left to the current solve (max_newton_steps)
+  FrictionalWorkspace::Newton* buffers_ = nullptr;  // the current solve's Newton buffers
 };
 
 /// Solves a problem given in local form (impetus/modules/contact_problem.hpp; fclib's layout, e.g. read

@@ -21,7 +21,6 @@
 
 #include <compare>
 #include <cstdint>
-#include <map>
 #include <memory>
 #include <vector>
 
@@ -137,9 +136,9 @@ class LedasResolver final : public CollisionResolver {
   void velocity_paper(ledas::Island& island, std::span<RigidBody> bodies, Lane& lane);
   void velocity_complementary(ledas::Island& island, std::span<RigidBody> bodies, Lane& lane);
   void velocity_frictional(ledas::Island& island, std::span<RigidBody> bodies, Lane& lane);
-  ledas::Vector solve_frictional(Lane& lane, ledas::Island& island, const ledas::Vector& q,
-                                 const ledas::Vector* start = nullptr);
-  ledas::Vector warm_start(const ledas::Island& island) const;
+  ledas::Vector& solve_frictional(Lane& lane, ledas::Island& island, const ledas::Vector& v,
+                                  const ledas::Vector& target, bool warm);
+  bool warm_start(ledas::Island& island) const;
   void remember_impulses(Lane& lane, const ledas::Island& island, std::span<const Contact> contacts) const;
   void apply_island_impulse(ledas::Island& island, const ledas::Vector& p, std::span<RigidBody> bodies,
                             Lane& lane);
