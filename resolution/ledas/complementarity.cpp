@@ -51,7 +51,16 @@ std::unique_ptr<MaskedLdlt> ComplementaritySolver::checkout_masked(const SparseM
       return f;
     }
   }
-  auto f = std::make_unique<MaskedLdlt>();
+  // A new pattern. With the cache full, its least recently used factorization is analysed again in
+  // place: its buffers (L's pattern and values: megabytes for a large island) were sized and touched
+  // before, so a scene whose pattern changes every step does not allocate and page in fresh ones.
+  std::unique_ptr<MaskedLdlt> f;
+  if (masked_cache_.size() >= kCacheCapacity) {
+    f = std::move(masked_cache_.front());
+    masked_cache_.erase(masked_cache_.begin());
+  } else {
+    f = std::make_unique<MaskedLdlt>();
+  }
   f->analyze(m, likely);
   ++stats.symbolic_analyses;
   return f;
