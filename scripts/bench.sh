@@ -21,15 +21,18 @@ if [ $quick = 1 ]; then
   reps=3
   export IMPETUS_BENCH_MAX_BODIES=210
 fi
+cpu_model=$(sed -n 's/^model name[[:space:]]*: //p' /proc/cpuinfo | head -n 1)
 run_as() {  # run_as OUT NAME [extra args]: bench_NAME → docs/data/OUT.json
   local out=$1 name=$2; shift 2
   echo "== bench_$name → $out.json"
   "$build/bin/bench_$name" --benchmark_repetitions=$reps --benchmark_report_aggregates_only=true \
     --benchmark_min_time=0.1 --benchmark_format=console --benchmark_out_format=json \
-    --benchmark_out="$data/$out.json" --benchmark_context=impetus_build_type=RelWithDebInfo "$@"
+    --benchmark_out="$data/$out.json" --benchmark_context=impetus_build_type=RelWithDebInfo \
+    --benchmark_context=cpu_model="$cpu_model" "$@"
 }
 run() { run_as "$1" "$@"; }  # run NAME [extra args]: bench_NAME → docs/data/NAME.json
-run resolve
+run resolve --benchmark_filter='^resolve/'
+run_as resolve_cold resolve --benchmark_filter='^resolve_cold/'
 # The dynamic scenes' rows (…_t1, …_t2) go to their own file: they run long (a 10,000-sphere heap).
 run step --benchmark_filter='-_t[0-9]+$'
 run_as dynamic step --benchmark_filter='_t[0-9]+$'

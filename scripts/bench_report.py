@@ -95,15 +95,9 @@ def scene_order(scene):
 
 def machine(context):
     """One line describing the machine, the compiler and the benchmark library's context."""
-    cpu = platform.processor() or "unknown CPU"
-    try:
-        with open("/proc/cpuinfo") as f:
-            for line in f:
-                if line.startswith("model name"):
-                    cpu = line.split(":", 1)[1].strip()
-                    break
-    except OSError:
-        pass
+    # The CPU the benchmarks ran on (scripts/bench.sh records it in the context); data without it were
+    # produced before it was recorded, and the machine that runs this report may be another one.
+    cpu = context.get("cpu_model") or "CPU not recorded"
     try:
         compiler = subprocess.run(["c++", "--version"], capture_output=True, text=True).stdout.splitlines()[0]
     except (OSError, IndexError):
@@ -285,6 +279,21 @@ def dynamic_table(rows):
     return "\n".join(lines)
 
 
+def cold_table(rows):
+    """bench_resolve's resolve_cold rows: the first solve of a new contact pattern against a repeated one."""
+    lines = ["| Scene | Bodies | Contacts | Cold (median) | Warm (mean, same run) | Cold / warm | Analyses per cold solve |",
+             "|---|---:|---:|---:|---:|---:|---:|"]
+    entries = []
+    for name, row in rows.items():
+        parts = name.split("/")
+        if len(parts) == 3 and parts[0] == "resolve_cold" and "error" not in row:
+            entries.append((scene_order(parts[2]), parts[2], row))
+    for _, scene, row in sorted(entries):
+        lines.append(f"| {scene} | {row['bodies']:.0f} | {row['contacts']:.0f} | {seconds(row['seconds'])} | "
+                     f"{seconds(row['warm_ms'] * 1e-3)} | {row['cold_over_warm']:.2f} | {row['analyses']:.0f} |")
+    return "\n".join(lines)
+
+
 def dynamic_peers_table(rows):
     """bench_peers' rows on the dynamic heap: one whole step under gravity from its snapshot per engine."""
     entries = []
@@ -380,6 +389,17 @@ def main():
            scaling_table(fits), "",
            "## Every row of the `resolve` family", "",
            full_table(res), ""]
+    cold = load(os.path.join(data_dir, "resolve_cold.json"))
+    if cold:
+        out += ["## A new contact pattern (`resolve_cold` rows)", "",
+                "A running resolver handed a contact pattern it has not seen (the prepared contacts rotated to "
+                "one of 40 start points: the same problem, rows in a new order, more patterns than ledas caches "
+                "analyses of), against the same pattern solved again right after (the warm solve of the rows "
+                "above). The cold solve pays the symbolic analysis (AMD ordering, elimination tree, row patterns "
+                "of L); with friction the frictional solver, which keeps no analysis, dominates both. "
+                "`benchmarks/resolve.cpp`, `resolve_cold`.", "",
+                f"Machine: {machine(cold['context'])}.", "",
+                cold_table(cold["rows"]), ""]
     if step:
         out += ["## A whole step under gravity (`step` family)", "",
                 "Detect + resolve + integrate from the drop/push state, position correction on; the stage split "
