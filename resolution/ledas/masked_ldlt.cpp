@@ -31,8 +31,7 @@ void MaskedLdlt::analyze(const Matrix& a, std::span<const char> rows) {
     for (SparseIndex k = 0; k < n; ++k) analysed_[k] = rows[static_cast<std::size_t>(k)] != 0;
   order_rows(a);
   upper_triangle();
-  elimination_tree();
-  row_patterns();
+  symbolic();
   l_value_.resize(l_index_.size());
   d_.assign(n, 1.0);
   d_inverse_.assign(n, 0.0);
@@ -57,12 +56,24 @@ void MaskedLdlt::order_rows(const Matrix& a) {
         kept.push_back(k);
       }
     const SparseIndex nk = kept.size();
-    Matrix sub(nk, nk);  // A's pattern on the analysed rows
-    std::vector<Eigen::Triplet<double>> entries;
+    // A's pattern on the analysed rows, column by column (A's row indices are sorted and `position`
+    // keeps their order, so each column comes out sorted).
+    SparseIndex entries = 0;
     for (const SparseIndex j : kept)
+      for (SparseIndex p = outer_[j]; p < outer_[j + 1]; ++p) entries += position[inner_[p]] >= 0 ? 1 : 0;
+    Matrix sub(nk, nk);
+    sub.resizeNonZeros(entries);
+    SparseIndex* sub_outer = sub.outerIndexPtr();
+    SparseIndex* sub_inner = sub.innerIndexPtr();
+    std::fill(sub.valuePtr(), sub.valuePtr() + entries, 1.0);
+    SparseIndex q = 0;
+    for (SparseIndex c = 0; c < nk; ++c) {
+      sub_outer[c] = q;
+      const SparseIndex j = kept[c];
       for (SparseIndex p = outer_[j]; p < outer_[j + 1]; ++p)
-        if (const SparseIndex i = position[inner_[p]]; i >= 0) entries.emplace_back(i, position[j], 1.0);
-    sub.setFromTriplets(entries.begin(), entries.end());
+        if (const SparseIndex i = position[inner_[p]]; i >= 0) sub_inner[q++] = i;
+    }
+    sub_outer[nk] = q;
     order_.clear();
     for (const SparseIndex k : minimum_degree(sub)) order_.push_back(kept[k]);
     for (SparseIndex k = 0; k < n; ++k)
@@ -99,50 +110,37 @@ void MaskedLdlt::upper_triangle() {
     }
 }
 
-// Elimination tree and column counts of L (ldl_symbolic); the column starts of L.
-void MaskedLdlt::elimination_tree() {
+// The elimination tree, the column counts and column starts of L (ldl_symbolic), and the pattern of
+// every row of L (columns i < k, in a topological order of the elimination tree: descendants first), in
+// one pass: row k's pattern is the set of tree paths from the entries of C's column k up to k, which is
+// the walk ldl_symbolic makes to find the parents and counts, so factorize() only reads it.
+void MaskedLdlt::symbolic() {
   const SparseIndex n = order_.size();
   parent_.assign(n, -1);
   flag_.assign(n, -1);
   l_count_.assign(n, 0);
-  for (SparseIndex k = 0; k < n; ++k) {
-    flag_[k] = k;
-    for (SparseIndex p = c_outer_[k]; p < c_outer_[k + 1]; ++p) {
-      for (SparseIndex i = c_row_[p]; i < k && flag_[i] != k; i = parent_[i]) {
-        if (parent_[i] == -1) parent_[i] = k;
-        ++l_count_[i];
-        flag_[i] = k;
-      }
-    }
-  }
-  l_outer_.assign(n + 1, 0);
-  for (SparseIndex k = 0; k < n; ++k) l_outer_[k + 1] = l_outer_[k] + l_count_[k];
-  l_index_.resize(l_outer_.back());
-}
-
-// The pattern of every row of L (columns i < k, in a topological order of the elimination tree:
-// descendants first), found once here by the etree walk ldl_numeric does per row, so factorize() only
-// reads it.
-void MaskedLdlt::row_patterns() {
-  const SparseIndex n = order_.size();
   pattern_.assign(n, 0);
   row_outer_.assign(n + 1, 0);
-  row_index_.resize(l_index_.size());
-  flag_.assign(n, -1);
-  for (SparseIndex k = 0, q = 0; k < n; ++k) {
+  row_index_.clear();
+  for (SparseIndex k = 0; k < n; ++k) {
     flag_[k] = k;
     SparseIndex top = n;
     for (SparseIndex p = c_outer_[k]; p < c_outer_[k + 1]; ++p) {
       SparseIndex len = 0;
       for (SparseIndex i = c_row_[p]; flag_[i] != k; i = parent_[i]) {
+        if (parent_[i] == -1) parent_[i] = k;
+        ++l_count_[i];
         pattern_[len++] = i;
         flag_[i] = k;
       }
       while (len > 0) pattern_[--top] = pattern_[--len];
     }
-    for (; top < n; ++top) row_index_[q++] = pattern_[top];
-    row_outer_[k + 1] = q;
+    for (; top < n; ++top) row_index_.push_back(pattern_[top]);
+    row_outer_[k + 1] = row_index_.size();
   }
+  l_outer_.assign(n + 1, 0);
+  for (SparseIndex k = 0; k < n; ++k) l_outer_[k + 1] = l_outer_[k] + l_count_[k];
+  l_index_.resize(l_outer_.back());
 }
 
 bool MaskedLdlt::covers(std::span<const char> on) const {

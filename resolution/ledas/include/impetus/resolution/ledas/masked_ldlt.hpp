@@ -122,11 +122,10 @@ class MaskedLdlt {
   static constexpr char kOff = 0, kOn = 1, kDropped = 2;
   static IndexVector<SparseIndex> minimum_degree(const Matrix& a);
   // The steps of analyze(): order_ and new_of_old_; the upper triangle of P A Pᵀ; the elimination tree,
-  // column counts and column starts of L; the pattern of each row of L.
+  // column counts and column starts of L with the pattern of each row of L.
   void order_rows(const Matrix& a);
   void upper_triangle();
-  void elimination_tree();
-  void row_patterns();
+  void symbolic();
 
   IndexVector<SparseIndex> outer_, inner_;       // the pattern of A
   IndexVector<char> analysed_;                   // per row: in the analysed pattern (may be in F)
