@@ -506,7 +506,7 @@ void FrictionalSolver::solve(const FrictionalProblem& problem, FrictionalStats& 
   const Eigen::Index m = problem.q.size();
   ++stats.problems;
   const bool warm = problem.start != nullptr && problem.start->size() == m && problem.start->allFinite();
-  r.setZero(m);
+  if (!(warm && problem.start == &r)) r.setZero(m);  // r may be the warm start itself
   double residual = 0.0;
   if (warm && !problem.convex) {
     // 0. The warm start (e.g. the last step's impulses): a resting body's usually solve the problem as

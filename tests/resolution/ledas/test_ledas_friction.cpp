@@ -220,5 +220,45 @@ TEST(LedasFriction, RelaxationAndCoulombMatchTheirClosedFormsOnOneContact) {
   EXPECT_NEAR(coulomb(2), 0.0, 1e-12);
 }
 
+// The overload that solves into the caller's vector, with a workspace, gives the bits of the one that
+// returns a new vector: from zero, from a warm start held elsewhere, and from a warm start that is the
+// output vector itself (slipping contact of the test above, Coulomb: r = (1, −0.5, 0) to 1e-12; the
+// warm start (0.9, −0.4, 0.1) does not solve it at once).
+TEST(LedasFriction, SolvingIntoAVectorMatchesTheReturnedSolution) {
+  const ledas::SparseMatrix w = Eigen::MatrixXd::Identity(3, 3).sparseView();
+  ledas::FrictionalProblem problem;
+  problem.w = &w;
+  problem.q = ledas::Vector::Zero(3);
+  problem.q << -1.0, 2.0, 0.0;
+  problem.role = {ledas::RowRole::normal, ledas::RowRole::tangent, ledas::RowRole::tangent};
+  problem.mu = {0.5, 0.0, 0.0};
+  problem.tolerance = 1e-13;
+  ledas::FrictionalSolver solver;
+  ledas::FrictionalStats stats;
+  const ledas::Vector cold = solver.solve(problem, stats);
+  ledas::Vector start(3);
+  start << 0.9, -0.4, 0.1;
+  problem.start = &start;
+  const ledas::Vector warm = solver.solve(problem, stats);
+
+  ledas::FrictionalWorkspace workspace;
+  problem.workspace = &workspace;
+  problem.start = nullptr;
+  ledas::Vector into;
+  solver.solve(problem, stats, into);
+  EXPECT_EQ(into, cold);
+  problem.start = &start;
+  solver.solve(problem, stats, into);
+  EXPECT_EQ(into, warm);
+  ledas::Vector itself = start;
+  problem.start = &itself;
+  solver.solve(problem, stats, itself);
+  EXPECT_EQ(itself, warm);
+  EXPECT_EQ(stats.non_converged, 0u);
+  EXPECT_NEAR(warm(0), 1.0, 1e-12);
+  EXPECT_NEAR(warm(1), -0.5, 1e-12);
+  EXPECT_NEAR(warm(2), 0.0, 1e-12);
+}
+
 }  // namespace
 }  // namespace impetus

@@ -142,7 +142,7 @@ class FrictionalSolver {
   /// unless counted in stats.non_converged.
   Vector solve(const FrictionalProblem& problem, FrictionalStats& stats);
   /// The same into `r` (its storage reused: with the problem's workspace, a problem its warm start solves
-  /// is solved without allocating).
+  /// is solved without allocating). `r` may be the warm start (`*problem.start`) itself.
   void solve(const FrictionalProblem& problem, FrictionalStats& stats, Vector& r);
 
   const FrictionalSettings& settings() const { return settings_; }
