@@ -192,12 +192,8 @@ TEST(LedasFriction, FrictionalSolverDoesNotDependOnTheTangentBasis) {
 namespace impetus {
 namespace {
 
-// The convex relaxation against its closed form on one contact with W = I, q = (−1, 2, 0), μ = 0.5: r is
-// the projection of −q on the cone, s = (1 + μ·2)/(1 + μ²) = 1.6, r = (1.6, −0.8, 0), and the contact
-// separates at u_n = μ‖u_t‖ = 0.6. Coulomb's problem on the same contact slides without separating:
-// u_n = 0, r = (1, −0.5, 0). Both to 1e-12.
-TEST(LedasFriction, RelaxationAndCoulombMatchTheirClosedFormsOnOneContact) {
-  const ledas::SparseMatrix w = Eigen::MatrixXd::Identity(3, 3).sparseView();
+// One frictional contact with W = `w`, q = (−1, 2, 0), μ = 0.5, solved to 1e-13.
+ledas::FrictionalProblem one_pushed_contact(const ledas::SparseMatrix& w) {
   ledas::FrictionalProblem problem;
   problem.w = &w;
   problem.q = ledas::Vector::Zero(3);
@@ -205,6 +201,16 @@ TEST(LedasFriction, RelaxationAndCoulombMatchTheirClosedFormsOnOneContact) {
   problem.role = {ledas::RowRole::normal, ledas::RowRole::tangent, ledas::RowRole::tangent};
   problem.mu = {0.5, 0.0, 0.0};
   problem.tolerance = 1e-13;
+  return problem;
+}
+
+// The convex relaxation against its closed form on one contact with W = I, q = (−1, 2, 0), μ = 0.5: r is
+// the projection of −q on the cone, s = (1 + μ·2)/(1 + μ²) = 1.6, r = (1.6, −0.8, 0), and the contact
+// separates at u_n = μ‖u_t‖ = 0.6. Coulomb's problem on the same contact slides without separating:
+// u_n = 0, r = (1, −0.5, 0). Both to 1e-12.
+TEST(LedasFriction, RelaxationAndCoulombMatchTheirClosedFormsOnOneContact) {
+  const ledas::SparseMatrix w = Eigen::MatrixXd::Identity(3, 3).sparseView();
+  ledas::FrictionalProblem problem = one_pushed_contact(w);
   ledas::FrictionalSolver solver;
   ledas::FrictionalStats stats;
   const ledas::Vector coulomb = solver.solve(problem, stats);
@@ -226,13 +232,7 @@ TEST(LedasFriction, RelaxationAndCoulombMatchTheirClosedFormsOnOneContact) {
 // warm start (0.9, −0.4, 0.1) does not solve it at once).
 TEST(LedasFriction, SolvingIntoAVectorMatchesTheReturnedSolution) {
   const ledas::SparseMatrix w = Eigen::MatrixXd::Identity(3, 3).sparseView();
-  ledas::FrictionalProblem problem;
-  problem.w = &w;
-  problem.q = ledas::Vector::Zero(3);
-  problem.q << -1.0, 2.0, 0.0;
-  problem.role = {ledas::RowRole::normal, ledas::RowRole::tangent, ledas::RowRole::tangent};
-  problem.mu = {0.5, 0.0, 0.0};
-  problem.tolerance = 1e-13;
+  ledas::FrictionalProblem problem = one_pushed_contact(w);
   ledas::FrictionalSolver solver;
   ledas::FrictionalStats stats;
   const ledas::Vector cold = solver.solve(problem, stats);
