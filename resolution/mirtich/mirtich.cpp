@@ -5,21 +5,15 @@
 
 #include <algorithm>
 #include <cmath>
+#include <memory>
 #include <span>
 #include <utility>
 #include <vector>
 
 namespace impetus {
-namespace {
-
-using resolution::ImpulseRow;
-
-// A pseudo-impulse pass whose largest change of separation is below this (m) has converged.
-constexpr double kPositionTolerance = 1e-11;
-
 // What the two passes share for one resolve() call. Arrays are indexed by contact (= row) index.
-struct Workspace {
-  std::vector<ImpulseRow> rows;
+struct MirtichWorkspace {
+  std::vector<resolution::ImpulseRow> rows;
   std::vector<double> a_kk;      // A_kk = 1/m_eff (eq. 7, i = k)
   // Current v_n − t of each row (m/s), refreshed after every impulse: the approach beyond the row's
   // target t = gap_target (0 unless the contact has a gap, then −gap/dt: it may close by the step's end).
@@ -32,19 +26,37 @@ struct Workspace {
   std::span<const Contact> contacts;
   resolution::Incidence incidence;  // rows ↔ movable bodies (slot = body index; fixed bodies: none)
   std::vector<std::size_t> local;  // row → its position in the island being corrected
+  std::vector<std::uint32_t> all;             // 0 … m − 1
+  std::vector<std::int32_t> slot_of_body;     // body → incidence slot (−1: fixed)
+  resolution::IslandSet islands;
+  // correct_island's, per row of the island: target, pseudo-impulse q, separation A q, the row, and the
+  // sparse coupling to the rows sharing a body with it (column j: coupling[coupling_start[j] …]).
+  std::vector<double> correction_target, q, separation;
+  std::vector<const resolution::ImpulseRow*> correction_rows;
+  std::vector<std::size_t> coupling_start;
+  std::vector<std::pair<std::size_t, double>> coupling;
+  std::vector<std::uint32_t> neighbour_rows;  // neighbours()'s answer
 
-  // Every row sharing a movable body with row k (k included, each once), sorted.
-  std::vector<std::uint32_t> neighbours(std::uint32_t k) const {
-    std::vector<std::uint32_t> out;
+  // Every row sharing a movable body with row k (k included, each once), sorted, into `out`.
+  void neighbours(std::uint32_t k, std::vector<std::uint32_t>& out) const {
+    out.clear();
     for (const std::int32_t s : incidence.slots[k]) {
       const std::span<const std::uint32_t> of_body = incidence.rows_of(s);
       out.insert(out.end(), of_body.begin(), of_body.end());
     }
     std::sort(out.begin(), out.end());
     out.erase(std::unique(out.begin(), out.end()), out.end());
-    return out;
   }
 };
+
+namespace {
+
+using resolution::ImpulseRow;
+
+// A pseudo-impulse pass whose largest change of separation is below this (m) has converged.
+constexpr double kPositionTolerance = 1e-11;
+
+using Workspace = MirtichWorkspace;
 
 // Refreshes v_n of every row that shares a movable body with row k (recomputed from the velocities).
 void refresh_neighbours(std::uint32_t k, Workspace& ws, std::span<const RigidBody> bodies) {
@@ -131,7 +143,7 @@ bool apply_single_impulse(std::uint32_t k, Workspace& ws, std::span<RigidBody> b
 
 // The velocity sweep over one island. Returns the number of single impulses applied; `capped` tells
 // whether the sweep stopped at the cap with a contact still approaching.
-std::uint64_t sweep_island(const std::vector<std::uint32_t>& island, Workspace& ws, std::span<RigidBody> bodies,
+std::uint64_t sweep_island(std::span<const std::uint32_t> island, Workspace& ws, std::span<RigidBody> bodies,
                            const MirtichSettings& settings, ResolverCounters& counters, bool& capped) {
   const std::uint64_t cap = settings.impulse_cap(island.size());
   const double tol = settings.tolerance;
@@ -174,9 +186,10 @@ std::uint64_t sweep_island(const std::vector<std::uint32_t>& island, Workspace& 
 
 // Position correction of one island (resting.hpp): projected Gauss–Seidel on pseudo-impulses q ≥ 0
 // with accumulated clamping for A q ≥ target, then one displacement per row. Velocities are untouched.
-void correct_island(const std::vector<std::uint32_t>& island, Workspace& ws, std::span<const Contact> contacts,
+void correct_island(std::span<const std::uint32_t> island, Workspace& ws, std::span<const Contact> contacts,
                     std::span<RigidBody> bodies, const MirtichSettings& settings, ResolverCounters& counters) {
-  std::vector<double> target(island.size());
+  std::vector<double>& target = ws.correction_target;
+  target.resize(island.size());
   bool any = false;
   double total_target = 0.0;  // Σ targets: the displacement bound's scale (resting.hpp)
   for (std::size_t j = 0; j < island.size(); ++j) {
@@ -189,12 +202,19 @@ void correct_island(const std::vector<std::uint32_t>& island, Workspace& ws, std
   // Local indices and the sparse coupling of each row to the rows it shares a body with (eq. 7).
   // Rows sharing a body are always in the same island, so `local` is only read where just written.
   for (std::size_t j = 0; j < island.size(); ++j) ws.local[island[j]] = j;
-  std::vector<std::vector<std::pair<std::size_t, double>>> column(island.size());
-  for (std::size_t j = 0; j < island.size(); ++j)
-    for (std::uint32_t i : ws.neighbours(island[j]))
-      column[j].emplace_back(ws.local[i], resolution::coupling(ws.rows[i], ws.rows[island[j]]));
+  ws.coupling.clear();
+  ws.coupling_start.resize(island.size() + 1);
+  for (std::size_t j = 0; j < island.size(); ++j) {
+    ws.coupling_start[j] = ws.coupling.size();
+    ws.neighbours(island[j], ws.neighbour_rows);
+    for (std::uint32_t i : ws.neighbour_rows)
+      ws.coupling.emplace_back(ws.local[i], resolution::coupling(ws.rows[i], ws.rows[island[j]]));
+  }
+  ws.coupling_start[island.size()] = ws.coupling.size();
 
-  std::vector<double> q(island.size(), 0.0), separation(island.size(), 0.0);  // separation = A q (m)
+  std::vector<double>&q = ws.q, &separation = ws.separation;  // separation = A q (m)
+  q.assign(island.size(), 0.0);
+  separation.assign(island.size(), 0.0);
   for (int pass = 0; pass < settings.position_iterations; ++pass) {
     double largest_change = 0.0;
     for (std::size_t j = 0; j < island.size(); ++j) {
@@ -204,13 +224,15 @@ void correct_island(const std::vector<std::uint32_t>& island, Workspace& ws, std
       const double dq = q_new - q[j];
       if (dq == 0.0) continue;
       q[j] = q_new;
-      for (const auto& [i, a_ik] : column[j]) separation[i] += a_ik * dq;
+      for (std::size_t e = ws.coupling_start[j]; e < ws.coupling_start[j + 1]; ++e)
+        separation[ws.coupling[e].first] += ws.coupling[e].second * dq;
       largest_change = std::max(largest_change, std::abs(dq) * ws.a_kk[k]);
     }
     if (largest_change < kPositionTolerance) break;
   }
   // No correction moves a body absurdly far (the displacement bound, resting.hpp).
-  std::vector<const resolution::ImpulseRow*> rows(island.size());
+  std::vector<const resolution::ImpulseRow*>& rows = ws.correction_rows;
+  rows.resize(island.size());
   for (std::size_t j = 0; j < island.size(); ++j) rows[j] = &ws.rows[island[j]];
   const resolution::CorrectionBound bound =
       resolution::bound_correction(rows, q, resolution::kCorrectionBoundFactor * total_target, bodies);
@@ -243,17 +265,21 @@ void record_outcomes(const Workspace& ws, std::span<Contact> contacts, std::span
 
 }  // namespace
 
-MirtichResolver::MirtichResolver(const ModuleOptions& options) : settings_(MirtichSettings::from_options(options)) {}
+MirtichResolver::MirtichResolver(const ModuleOptions& options)
+    : settings_(MirtichSettings::from_options(options)), work_(std::make_unique<MirtichWorkspace>()) {}
 
-MirtichResolver::MirtichResolver(const MirtichSettings& settings) : settings_(settings) {}
+MirtichResolver::MirtichResolver(const MirtichSettings& settings)
+    : settings_(settings), work_(std::make_unique<MirtichWorkspace>()) {}
+
+MirtichResolver::~MirtichResolver() = default;
 
 void MirtichResolver::resolve(std::span<RigidBody> bodies, std::span<Contact> contacts,
                               std::span<const Constraint> /*constraints*/, const StepContext& ctx,
                               ResolverCounters& counters) noexcept {
   try {
-    Workspace ws;
+    Workspace& ws = *work_;  // its vectors keep their storage from the last call
     const std::size_t m = contacts.size();
-    ws.rows.reserve(m);
+    ws.rows.clear();
     for (const Contact& c : contacts) ws.rows.push_back(resolution::make_contact_row(bodies, c));
     ws.a_kk.resize(m);
     ws.vn.resize(m);
@@ -275,14 +301,16 @@ void MirtichResolver::resolve(std::span<RigidBody> bodies, std::span<Contact> co
         if (!bodies[row.a].fixed || !bodies[row.b].fixed) ++counters.singular_systems;
       }
     }
-    std::vector<std::uint32_t> all(m);
-    std::vector<std::int32_t> slot_of_body(bodies.size());
-    for (std::uint32_t k = 0; k < m; ++k) all[k] = k;
-    for (std::size_t s = 0; s < bodies.size(); ++s) slot_of_body[s] = bodies[s].fixed ? -1 : static_cast<std::int32_t>(s);
-    ws.incidence = resolution::Incidence(ws.rows, all, bodies.size(), slot_of_body);
+    ws.all.resize(m);
+    ws.slot_of_body.resize(bodies.size());
+    for (std::uint32_t k = 0; k < m; ++k) ws.all[k] = k;
+    for (std::size_t s = 0; s < bodies.size(); ++s)
+      ws.slot_of_body[s] = bodies[s].fixed ? -1 : static_cast<std::int32_t>(s);
+    ws.incidence.assign(ws.rows, ws.all, bodies.size(), ws.slot_of_body);
 
-    const auto islands = resolution::find_islands(ws.rows, bodies.size(), bodies);
-    for (const auto& island : islands) {
+    resolution::find_islands(ws.rows, bodies.size(), bodies, ws.islands);
+    for (std::size_t i = 0; i < ws.islands.size(); ++i) {
+      const std::span<const std::uint32_t> island = ws.islands.island(i);
       bool capped = false;
       counters.rounds += sweep_island(island, ws, bodies, settings_, counters, capped);
       if (capped) ++counters.non_converged;
@@ -294,7 +322,8 @@ void MirtichResolver::resolve(std::span<RigidBody> bodies, std::span<Contact> co
     counters.residual = std::max(counters.residual, residual.max_approach);
     counters.complementarity_error = std::max(counters.complementarity_error, residual.complementarity);
     record_outcomes(ws, contacts, bodies, settings_.tolerance, counters);
-    for (const auto& island : islands) correct_island(island, ws, contacts, bodies, settings_, counters);
+    for (std::size_t i = 0; i < ws.islands.size(); ++i)
+      correct_island(ws.islands.island(i), ws, contacts, bodies, settings_, counters);
   } catch (...) {
     // Only allocation can throw here; report it as a failed (non-converged) resolution.
     ++counters.non_converged;

@@ -24,8 +24,11 @@
 #include "impetus/settings/mirtich.hpp"  // MirtichSettings
 
 #include <cstdint>
+#include <memory>
 
 namespace impetus {
+
+struct MirtichWorkspace;  // resolve()'s buffers (mirtich.cpp)
 
 /// Sequential single-contact impulses, island by island:
 ///  1. velocity sweep: while some contact approaches (v_n < −tolerance) and the island's cap is not
@@ -46,6 +49,9 @@ namespace impetus {
 /// collision, ≤ 0). natural_map_residual stays 0: a sequential resolver solves no simultaneous
 /// frictional problem to measure it on.
 ///
+/// Its buffers are kept from call to call: once a scene's contact count and islands stop growing, a
+/// call allocates nothing. Not thread-safe (one resolver per world, as every resolver).
+///
 /// Each contact receives Contact::impulse (Σ p_n), Contact::tangent_impulse (Σ p_t) and Contact::mode:
 /// separate if it received no impulse, stick if its slip after the sweep is at most `tolerance`, slide
 /// otherwise.
@@ -55,6 +61,7 @@ class MirtichResolver final : public CollisionResolver {
   explicit MirtichResolver(const ModuleOptions& options);
   /// Builds the resolver from settings directly (tests, embedding).
   explicit MirtichResolver(const MirtichSettings& settings);
+  ~MirtichResolver() override;
 
   /// Accepts Coulomb friction (Mirtich's frictional collision integration).
   ModuleStatus accept_friction() noexcept override { return ModuleStatus::success(); }
@@ -70,6 +77,7 @@ class MirtichResolver final : public CollisionResolver {
 
  private:
   MirtichSettings settings_;
+  std::unique_ptr<MirtichWorkspace> work_;
 };
 
 }  // namespace impetus
