@@ -217,15 +217,15 @@ ModuleStatus FclDetector::Impl::add_body(const RigidBody& body, BodyIndex index,
   entry.inner = inner_radius(entry.geometry);
   bodies.push_back(std::move(entry));
   if (bodies.back().geometry.kind == ShapeKind::plane) {
-    planes.push_back(index);  // planes never enter a tree: they are tested against the boxes directly
+    planes.push_back(index);  // planes never enter the broadphase: they are tested against the boxes directly
     return ModuleStatus::success();
   }
-  // A fixed body that moves (prescribed motion) has its box refreshed and lives in the movable tree like
-  // a movable body; it still never pairs with another fixed body (filtered()).
+  // A fixed body that moves (prescribed motion) has its box refreshed like a movable body's; it still
+  // never pairs with another fixed body (filtered()).
   const bool moves = !body.fixed || body.motion == PrescribedMotion::moving;
   if (moves) movable.push_back(index);
   boxes[index] = grown(world_aabb(placed(body, index)), 0.5 * settings.margin);
-  broadphase.add(index, bodies.back().fcl, !moves, boxes[index]);
+  broadphase.add(index, !moves, boxes[index]);
   return ModuleStatus::success();
 }
 
@@ -267,7 +267,7 @@ void FclDetector::detect(std::span<const RigidBody> bodies, const StepContext& c
 
   // 1. Broadphase: refresh the movable bodies' boxes (grown by half the margin each, so a gap up to the
   // margin still overlaps; a fast body's box also by its reach over the step, so whatever it can meet is
-  // a candidate), traverse the trees (fattened boxes: a superset), test the planes, keep the pairs whose
+  // a candidate), collect the pairs whose boxes overlap (the grid), test the planes, keep the pairs whose
   // exact boxes overlap and that pass the filters, sort.
   const bool speculative = s.settings.speculative && std::isfinite(ctx.dt) && ctx.dt > 0.0;
   s.pairs.clear();
@@ -293,7 +293,7 @@ void FclDetector::detect(std::span<const RigidBody> bodies, const StepContext& c
         grow += s.reach[i];
     }
     s.boxes[i] = grown(world_aabb(body), grow);
-    s.broadphase.move(i, s.boxes[i], 0.05 * body.size());
+    s.broadphase.move(i, s.boxes[i]);
   }
   // Candidate pairs are bounded by work: many bodies generated at one point would give n²/2 of them (and
   // up to four contacts each). Past the limit the detection is refused, naming the most crowded body.

@@ -1,11 +1,11 @@
 #pragma once
 /// \file
-/// The broadphase: FCL dynamic AABB trees behind an FCL-free interface. Movable bodies live in one
-/// tree updated incrementally (only the bodies whose box changed are re-fitted); fixed bodies live in a
-/// second tree built once, so two fixed bodies never form a pair. Planes are unbounded and never enter
-/// a tree: the detector tests them against the movable bodies' boxes itself.
+/// The broadphase: a hierarchical hash grid (Mirtich's "hierarchical hash tables"), rebuilt from the
+/// bodies' boxes at every collect() in time linear in the bodies: bodies of similar size share one
+/// uniform grid whose cell is twice their median box size, and much larger ones go to coarser grids.
+/// Two fixed bodies never form a pair. Planes are unbounded and never enter a grid: the detector tests
+/// them against the movable bodies' boxes itself.
 
-#include "impetus/detection/fcl/fcl_queries.hpp"
 #include "impetus/modules/detector.hpp"
 #include "impetus/detection/fcl/shapes.hpp"
 
@@ -23,18 +23,17 @@ class Broadphase {
 
   /// Forgets every body.
   void clear();
-  /// Registers body `index` with its FCL geometry and world box (already grown by the margin): a fixed
-  /// body goes to the static tree, a movable one to the dynamic tree. Call finish() after the last one.
-  void add(BodyIndex index, const FclShapePtr& shape, bool fixed, const Aabb& box);
-  /// Builds both trees (bulk, balanced).
+  /// Registers body `index` with its world box (already grown by the margin). Call finish() after the
+  /// last one.
+  void add(BodyIndex index, bool fixed, const Aabb& box);
+  /// Ends the registration (sizes the scratch, so collect() allocates nothing while the scene is stable).
   void finish();
-  /// Gives a movable body a new box. The tree keeps a fattened copy (grown by `slack`, m) and is only
-  /// updated, in collect(), when the box leaves it: resting or slow bodies cost nothing. So the pairs
-  /// are a superset of those whose boxes overlap; the caller checks the exact boxes.
-  void move(BodyIndex index, const Aabb& box, double slack);
-  /// Appends every pair whose boxes overlap, lower index first: movable–movable and movable–fixed.
-  /// The order is FCL's traversal order (the caller sorts). Stops once `pairs` holds `limit` entries and
-  /// returns false (the pairs are then a partial list); true when every pair was appended.
+  /// Gives a movable body a new box.
+  void move(BodyIndex index, const Aabb& box);
+  /// Appends every pair whose boxes overlap (boxes touching count), lower index first, each once:
+  /// movable–movable and movable–fixed. In no particular order (the caller sorts). Stops once `pairs`
+  /// holds `limit` entries and returns false (the pairs are then a partial list); true when every pair
+  /// was appended.
   bool collect(std::vector<BodyPair>& pairs, std::size_t limit);
 
  private:
