@@ -1,8 +1,8 @@
 #pragma once
 /// \file
-/// The broadphase: a hierarchical hash grid (Mirtich's "hierarchical hash tables"), rebuilt from the
-/// bodies' boxes at every collect() in time linear in the bodies: bodies of similar size share one
-/// uniform grid whose cell is twice their median box size, and much larger ones go to coarser grids.
+/// The broadphase: a hierarchical grid, rebuilt from the bodies' boxes at every collect() in time about
+/// linear in the bodies: bodies of similar size share one uniform grid whose cell is a little larger
+/// than their largest box, and much larger ones go to coarser grids (detection/fcl/README.md).
 /// Two fixed bodies never form a pair. Planes are unbounded and never enter a grid: the detector tests
 /// them against the movable bodies' boxes itself.
 
