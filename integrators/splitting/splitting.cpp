@@ -51,15 +51,16 @@ SplittingIntegrator::SplittingIntegrator(const ModuleOptions& options)
 
 void SplittingIntegrator::integrate_velocities(std::span<RigidBody> bodies, const StepContext& ctx,
                                                IntegratorCounters& /*counters*/) noexcept {
-  for (RigidBody& body : bodies)
-    if (!body.fixed && !body.asleep) integrators::integrate_velocity(body, ctx);
+  IntegratorCounters unused;
+  integrators::for_each_moving_body(bodies, unused, [&](RigidBody& body, IntegratorCounters&) {
+    integrators::integrate_velocity(body, ctx);
+  });
 }
 
 void SplittingIntegrator::integrate_positions(std::span<RigidBody> bodies, const StepContext& ctx,
                                               IntegratorCounters& counters) noexcept {
   const double dt = ctx.dt;
-  for (RigidBody& body : bodies) {
-    if (body.fixed || body.asleep) continue;
+  integrators::for_each_moving_body(bodies, counters, [&](RigidBody& body, IntegratorCounters& count) {
     // eq. (2), row 3, with the velocity already updated (and resolved): symplectic Euler.
     body.position += dt * body.velocity;
 
@@ -78,13 +79,13 @@ void SplittingIntegrator::integrate_positions(std::span<RigidBody> bodies, const
     body.rotation = q * frame.axes.transpose();
     if (settings_.orthonormalize) {
       body.rotation = orthonormalized(body.rotation);
-      ++counters.orthonormalized;
+      ++count.orthonormalized;
     }
     // ω = J_world(R')⁻¹ L, right to left as in MomentumIntegrator.
     body.angular_velocity =
         body.rotation * (body.inv_inertia_body * (body.rotation.transpose() * angular_momentum));
-    ++counters.bodies;
-  }
+    ++count.bodies;
+  });
 }
 
 }  // namespace impetus

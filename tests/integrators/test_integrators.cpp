@@ -6,6 +6,7 @@
 #include "impetus/integrators/splitting/splitting.hpp"
 
 #include <gtest/gtest.h>
+#include <tbb/task_arena.h>
 
 #include <algorithm>
 #include <cmath>
@@ -120,6 +121,54 @@ TYPED_TEST(BothIntegrators, ForceAndTorqueGiveTheAnalyticVelocityChange) {
   const Vec3 dw = ctx.dt * ball.torque / moment;
   EXPECT_LE((ball.velocity - v0 - dv).norm(), 1e-12 * dv.norm());
   EXPECT_LE((ball.angular_velocity - w0 - dw).norm(), 1e-12 * dw.norm());
+}
+
+// Law: each body is advanced on its own, so 3,000 bodies (three parallel chunks) advanced on 1 or 4
+// threads end bit for bit where one body advanced alone ends; fixed and sleeping bodies do not move, and
+// the count of advanced bodies is exact.
+TYPED_TEST(BothIntegrators, ManyBodiesAdvanceAsEachAloneOnAnyThreadCount) {
+  TypeParam integrator{ModuleOptions{}};
+  std::vector<RigidBody> start;
+  for (int i = 0; i < 3000; ++i) {
+    RigidBody b = principal_body(1.0 + 0.001 * i, Vec3(1.0, 2.0 + 0.0005 * i, 3.0));
+    b.position = Vec3(0.01 * i, -0.02 * i, 0.5);
+    b.rotation = rotation_from_vector(Vec3(0.001 * i, 0.3, -0.2));
+    b.velocity = Vec3(0.1, 0.0002 * i, -0.3);
+    b.angular_velocity = Vec3(1.0, -0.001 * i, 0.5);
+    b.fixed = i % 97 == 0;
+    b.asleep = i % 101 == 0;
+    start.push_back(b);
+  }
+  StepContext ctx;
+  ctx.dt = 0.01;
+  const auto advanced = [&](int threads, std::vector<RigidBody>& bodies) {
+    IntegratorCounters counters;
+    tbb::task_arena arena(threads);
+    arena.execute([&] {
+      integrator.integrate_velocities(bodies, ctx, counters);
+      integrator.integrate_positions(bodies, ctx, counters);
+    });
+    return counters.bodies;
+  };
+  std::vector<RigidBody> one = start, four = start;
+  const std::uint64_t moved = advanced(1, one);
+  EXPECT_EQ(advanced(4, four), moved);
+  std::uint64_t expected = 0;
+  for (std::size_t i = 0; i < start.size(); ++i) {
+    std::vector<RigidBody> alone{start[i]};
+    advanced(1, alone);
+    expected += !start[i].fixed && !start[i].asleep;
+    for (const std::vector<RigidBody>* run : {&one, &four}) {
+      const RigidBody& b = (*run)[i];
+      ASSERT_TRUE(b.position == alone[0].position && b.rotation == alone[0].rotation &&
+                  b.velocity == alone[0].velocity && b.angular_velocity == alone[0].angular_velocity)
+          << "body " << i;
+    }
+    if (start[i].fixed || start[i].asleep) {
+      EXPECT_TRUE(one[i].position == start[i].position) << "body " << i;
+    }
+  }
+  EXPECT_EQ(moved, expected);
 }
 
 // A body with principal moments (1, 2, 3) spun near its intermediate axis: the true motion tumbles

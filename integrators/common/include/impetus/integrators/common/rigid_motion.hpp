@@ -15,6 +15,9 @@
 #include "impetus/modules/step.hpp"
 #include "impetus/settings/integrators.hpp"  // RotationSettings
 
+#include <functional>
+#include <span>
+
 namespace impetus::integrators {
 
 /// Eq. 2, rows 1–2: gravity `ctx.gravity` (m/s²), the applied force `body.applied_force()` (N) and
@@ -27,5 +30,12 @@ void integrate_velocity(RigidBody& body, const StepContext& ctx);
 /// `counters.orthonormalized`). Leaves v and ω unchanged. The body must not be fixed.
 void advance_pose(RigidBody& body, double dt, const RotationSettings& settings,
                   IntegratorCounters& counters);
+
+/// Calls `advance(body, counters)` for every body that is neither fixed nor asleep: in parallel, on fixed
+/// chunks of bodies, when there is more than one chunk (the chunks do not depend on the thread count,
+/// and each body is advanced on its own, so the bodies come out the same for every thread count). Each
+/// chunk counts into its own counters; they are added to `counters`.
+void for_each_moving_body(std::span<RigidBody> bodies, IntegratorCounters& counters,
+                          const std::function<void(RigidBody&, IntegratorCounters&)>& advance);
 
 }  // namespace impetus::integrators
