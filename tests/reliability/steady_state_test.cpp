@@ -81,6 +81,24 @@ INSTANTIATE_TEST_SUITE_P(
                     }()}),
     [](const testing::TestParamInfo<SteadyScene>& info) { return info.param.name; });
 
+// `count` unit boxes stacked on the ground, 10 µm into each other and the ground, all with friction μ.
+std::string box_stack(int count, double mu) {
+  const std::string friction = std::to_string(mu);
+  std::string text = "bodies:\n  - {name: ground, fixed: true, friction: " + friction +
+                     ", shape: {plane: {normal: [0, 0, 1]}}}\n";
+  for (int i = 0; i < count; ++i)
+    text += "  - {name: box" + std::to_string(i) + ", shape: {box: {size: [1, 1, 1]}}, mass: 1, friction: " + friction +
+            ", position: [0, 0, " + std::to_string(0.49999 + 0.99999 * i) + "]}\n";
+  return text;
+}
+
+// A test name from the scene's name (a test name has no dots).
+std::string test_name(const testing::TestParamInfo<SteadyScene>& info) {
+  std::string name = info.param.name;
+  std::replace(name.begin(), name.end(), '.', '_');
+  return name;
+}
+
 // With Coulomb friction: the frictional solver (resolution/ledas/frictional_solver.hpp) from its warm
 // start, polished by Newton steps where it does not solve at once, in each island's buffers. Newton's
 // systems of more than FrictionalSettings::dense_limit rows (96) are factorized by Eigen's SparseLU, which
@@ -92,18 +110,8 @@ INSTANTIATE_TEST_SUITE_P(
         SteadyScene{"pyramid_4_mu0.7", kModules + "generators:\n  - pyramid: {rows: 4, radius: 0.5, friction: 0.7}\n"},
         // Five unit boxes stacked on the ground with μ = 0.5: four contacts per face, more rows than
         // degrees of freedom (a redundant contact set; the warm start needs Newton's polish).
-        SteadyScene{"stack_5_mu0.5", kModules + [] {
-                      std::string text = "bodies:\n  - {name: ground, fixed: true, friction: 0.5, shape: {plane: {normal: [0, 0, 1]}}}\n";
-                      for (int i = 0; i < 5; ++i)
-                        text += "  - {name: box" + std::to_string(i) + ", shape: {box: {size: [1, 1, 1]}}, mass: 1, friction: 0.5, "
-                                "position: [0, 0, " + std::to_string(0.49999 + 0.99999 * i) + "]}\n";
-                      return text;
-                    }()}),
-    [](const testing::TestParamInfo<SteadyScene>& info) {
-      std::string name = info.param.name;
-      std::replace(name.begin(), name.end(), '.', '_');
-      return name;
-    });
+        SteadyScene{"stack_5_mu0.5", kModules + box_stack(5, 0.5)}),
+    test_name);
 
 // The sequential resolver (mirtich) keeps its buffers too: the same resting pyramid, and the stack of
 // boxes with friction (Mirtich's frictional collision integration). Not the line: a line of 100 spheres
@@ -114,18 +122,8 @@ const std::string kMirtich = "modules: {integrator: momentum, detector: fcl, res
 INSTANTIATE_TEST_SUITE_P(
     Sequential, SteadyState,
     testing::Values(SteadyScene{"pyramid_10", kMirtich + "generators:\n  - pyramid: {rows: 10, radius: 0.5}\n"},
-                    SteadyScene{"stack_5_mu0.5", kMirtich + [] {
-                                  std::string text = "bodies:\n  - {name: ground, fixed: true, friction: 0.5, shape: {plane: {normal: [0, 0, 1]}}}\n";
-                                  for (int i = 0; i < 5; ++i)
-                                    text += "  - {name: box" + std::to_string(i) + ", shape: {box: {size: [1, 1, 1]}}, mass: 1, friction: 0.5, "
-                                            "position: [0, 0, " + std::to_string(0.49999 + 0.99999 * i) + "]}\n";
-                                  return text;
-                                }()}),
-    [](const testing::TestParamInfo<SteadyScene>& info) {
-      std::string name = info.param.name;
-      std::replace(name.begin(), name.end(), '.', '_');
-      return name;
-    });
+                    SteadyScene{"stack_5_mu0.5", kMirtich + box_stack(5, 0.5)}),
+    test_name);
 
 }  // namespace
 }  // namespace impetus::reliability
