@@ -212,7 +212,8 @@ void correct_island(std::span<const std::uint32_t> island, Workspace& ws, std::s
   }
   ws.coupling_start[island.size()] = ws.coupling.size();
 
-  std::vector<double>&q = ws.q, &separation = ws.separation;  // separation = A q (m)
+  std::vector<double>& q = ws.q;
+  std::vector<double>& separation = ws.separation;  // = A q (m)
   q.assign(island.size(), 0.0);
   separation.assign(island.size(), 0.0);
   for (int pass = 0; pass < settings.position_iterations; ++pass) {
