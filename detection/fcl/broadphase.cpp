@@ -242,7 +242,7 @@ bool Broadphase::Impl::pairs_within(const Level& level, std::size_t begin, std::
   const std::vector<Cell>& cells = level.cells;
   const auto key_less = [](const Cell& c, std::uint64_t key) { return c.key < key; };
   std::size_t cursor[13];
-  bool started = false;
+  bool placed[13] = {};  // a cursor is placed by a binary search the first time its direction is used
   for (std::size_t c = begin; c < end; ++c) {
     const Cell& cell = cells[c];
     for (std::uint32_t i = cell.begin; i < cell.end; ++i)
@@ -257,12 +257,14 @@ bool Broadphase::Impl::pairs_within(const Level& level, std::size_t begin, std::
       if (nx >= kCellRange || ny < 0 || ny >= kCellRange || nz < 0 || nz >= kCellRange) continue;
       const std::uint64_t key = pack(nx, ny, nz);
       std::size_t& k = cursor[d];
-      if (!started) k = static_cast<std::size_t>(std::lower_bound(cells.begin() + static_cast<std::ptrdiff_t>(c),
-                                                                  cells.end(), key, key_less) - cells.begin());
+      if (!placed[d]) {
+        k = static_cast<std::size_t>(std::lower_bound(cells.begin() + static_cast<std::ptrdiff_t>(c), cells.end(), key,
+                                                      key_less) - cells.begin());
+        placed[d] = true;
+      }
       while (k < cells.size() && cells[k].key < key) ++k;
       if (k < cells.size() && cells[k].key == key && !cells_against(level, cell, cells[k], sink)) return false;
     }
-    started = true;
   }
   return true;
 }

@@ -55,6 +55,11 @@ std::vector<Aabb> mixed_boxes(std::mt19937_64& random, std::vector<char>& fixed,
   fixed.push_back(0);
   boxes.push_back({Vec3::Constant(1e9), Vec3::Constant(1e9 + 1.0)});  // far out: clamped cells
   fixed.push_back(0);
+  // Far out below, at the lowest x: the first cell of the grid, clamped along y.
+  boxes.push_back({Vec3(-0.5, -1e9, 1.0), Vec3(-0.4, -1e9 + 0.1, 1.1)});
+  fixed.push_back(0);
+  boxes.push_back({Vec3(-0.45, -1e9 + 0.05, 1.05), Vec3(-0.3, -1e9 + 0.2, 1.2)});  // overlapping it
+  fixed.push_back(0);
   boxes.push_back({Vec3::Constant(std::numeric_limits<double>::quiet_NaN()), Vec3::Constant(1.0)});
   fixed.push_back(0);
   boxes.push_back({Vec3(-std::numeric_limits<double>::infinity(), 1.0, 1.0), Vec3(2.0, 2.0, 2.0)});
