@@ -196,15 +196,16 @@ void Broadphase::move(BodyIndex index, const Aabb& box) { impl_->boxes[index] = 
 
 // Levels: a level takes the bodies not yet placed whose largest box extent is at most kLevelSpread times
 // the median of theirs (at least half: at most log₂ n + 1 levels, and one for bodies of similar sizes);
-// its cell is kCellSlack times the largest of its boxes. A box with a non-finite extent is tested
-// against every body (NaN boxes overlap nothing).
+// its cell is kCellSlack times the largest of its boxes. A box with a non-finite corner or extent (two
+// finite corners 1e308 apart) is tested against every body (NaN boxes overlap nothing).
 void Broadphase::Impl::place_levels() {
   level_count = 0;
   unbounded.clear();
   remaining.clear();
   for (const BodyIndex b : bodies) {
     const Aabb& box = boxes[b];
-    (box.min.allFinite() && box.max.allFinite() ? remaining : unbounded).push_back(b);
+    const bool bounded = box.min.allFinite() && box.max.allFinite() && std::isfinite((box.max - box.min).maxCoeff());
+    (bounded ? remaining : unbounded).push_back(b);
   }
   while (!remaining.empty()) {
     extents.clear();

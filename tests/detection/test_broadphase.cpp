@@ -37,8 +37,8 @@ std::vector<BodyPair> collected(Broadphase& broadphase) {
 }
 
 // Boxes of sizes spread over four decades (1 mm to 20 m; a few fixed), some touching exactly, some far
-// out, one with a NaN corner and one unbounded: the grid's levels, its bucket collisions and the
-// fallbacks all meet.
+// out, one with a NaN corner, one unbounded and one whose extent overflows: the grid's levels, its
+// clamped border cells and the fallbacks all meet.
 std::vector<Aabb> mixed_boxes(std::mt19937_64& random, std::vector<char>& fixed, int n) {
   std::uniform_real_distribution<double> unit(0.0, 1.0);
   std::vector<Aabb> boxes;
@@ -63,6 +63,9 @@ std::vector<Aabb> mixed_boxes(std::mt19937_64& random, std::vector<char>& fixed,
   boxes.push_back({Vec3::Constant(std::numeric_limits<double>::quiet_NaN()), Vec3::Constant(1.0)});
   fixed.push_back(0);
   boxes.push_back({Vec3(-std::numeric_limits<double>::infinity(), 1.0, 1.0), Vec3(2.0, 2.0, 2.0)});
+  fixed.push_back(0);
+  // Finite corners whose extent overflows to infinity.
+  boxes.push_back({Vec3(-1.5e308, 3.0, 1.0), Vec3(1.5e308, 3.2, 1.2)});
   fixed.push_back(0);
   return boxes;
 }
