@@ -5,7 +5,7 @@ Usage: bench_report.py DATA_DIR DOCS_DIR
 
 DATA_DIR holds Google Benchmark JSON files (--benchmark_format=json): resolve.json, step.json,
 detect.json, dynamic.json (bench_step's dynamic rows) and, when the peers benchmark was built, peers.json
-and dynamic_peers.json (its rows on the dynamic heap). Medians are used where the run had
+and dynamic_peers.json (its rows on the dynamic scenes). Medians are used where the run had
 repetitions (aggregate "median"), else the single run. Writes DOCS_DIR/benchmarks.md and
 DOCS_DIR/charts/scaling.{png,svg} (and peers.{png,svg} with peers.json). Charts need matplotlib; without
 it the tables are still written and the charts are skipped with a message.
@@ -295,19 +295,24 @@ def cold_table(rows):
 
 
 def dynamic_peers_table(rows):
-    """bench_peers' rows on the dynamic heap: one whole step under gravity from its snapshot per engine."""
+    """bench_peers' rows on the dynamic scenes: one whole step under gravity from a snapshot per engine."""
+    families = ("heap_", "pile_", "knocked_wall_")
     entries = []
     for name, row in rows.items():
         parts = name.split("/")
-        if len(parts) == 3 and parts[2].startswith("heap_") and "error" not in row:
-            entries.append((int(parts[2].split("_")[1]), row["seconds"], parts[1].removesuffix("_gravity"), row))
+        if len(parts) == 3 and parts[2].startswith(families) and "error" not in row:
+            scene, _, mu = parts[2].partition("_mu")
+            family, n = scene.rsplit("_", 1)
+            order = [f.rstrip("_") for f in families].index(family)
+            entries.append((bool(mu), order, int(n), row["seconds"], parts[2], parts[1].removesuffix("_gravity"), row))
     entries.sort()
-    lines = ["| Heap | Method | Step (median) | Solver alone | Contacts found | Touching contacts missed | "
-             "Residual (m/s) | Complementarity |", "|---:|---|---:|---:|---:|---:|---:|---:|"]
-    for n, _, method, row in entries:
+    lines = ["| Scene | Method | Step (median) | Solver alone | Contacts found | Touching contacts missed | "
+             "Residual (m/s) | Complementarity | Natural map |", "|---|---|---:|---:|---:|---:|---:|---:|---:|"]
+    for *_, scene, method, row in entries:
         solver = seconds(row["solver_ms"] * 1e-3) if row.get("solver_ms") else "—"
-        lines.append(f"| {n} | {method} | {seconds(row['seconds'])} | {solver} | {row['engine_contacts']:.0f} | "
-                     f"{row['missing']:.0f} | {sci(row.get('residual'))} | {sci(row.get('complementarity'))} |")
+        lines.append(f"| {scene} | {method} | {seconds(row['seconds'])} | {solver} | {row['engine_contacts']:.0f} | "
+                     f"{row['missing']:.0f} | {sci(row.get('residual'))} | {sci(row.get('complementarity'))} | "
+                     f"{sci(row.get('natural_map'))} |")
     return "\n".join(lines)
 
 
@@ -417,9 +422,17 @@ def main():
                 "the steps; *deepest* the deepest contact a detection found.", "",
                 dynamic_table(dynamic["rows"]), ""]
     if dynamic_peers:
-        out += ["### The heap in every engine", "",
-                "One whole step under gravity from the heap's snapshot, each engine with its own detection "
-                "(Impetus on one thread, as the others); judged at the contacts that touch in the snapshot. An "
+        out += ["### The dynamic scenes in every engine", "",
+                "One whole step under gravity from each scene's snapshot (the heaps, the pile of 1,000 mixed "
+                "primitives in its bin, the wall of 200 bricks being knocked over), each engine with its own "
+                "detection (Impetus on one thread, as the others), judged at the contacts Impetus finds touching "
+                "in the snapshot: *residual* is the largest approach velocity there, *complementarity* the "
+                "largest impulse times separation over the pairs of bodies (a box's face is judged as one pair, "
+                "since each engine picks its own points on it; `benchmarks/peers/README.md`). Where engines "
+                "disagree on the geometry (a capsule on a box's edge), the judge is Impetus's detector. With "
+                "μ = 0.5 (`_mu0.5`), each engine's own friction law; *natural map* is fclib's error of the "
+                "impulses each engine reports, measured on the heap (one point per pair) and not on the pile "
+                "(its face contacts have each engine's own points). An "
                 "engine's step includes rebuilding its contact cache after the benchmark's reset of every body, "
                 "which a running simulation does not pay: *solver alone* is the fairer comparison of the solves.", "",
                 dynamic_peers_table(dynamic_peers["rows"]), ""]

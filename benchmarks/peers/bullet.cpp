@@ -1,5 +1,6 @@
 // Bullet (double-precision build, BT_USE_DOUBLE_PRECISION from pkg-config bullet-float64) on the peers'
-// scenes: a btDiscreteDynamicsWorld with the same spheres and planes, stepped once with dt.
+// scenes: a btDiscreteDynamicsWorld with the same bodies (btSphereShape, btBoxShape, btCapsuleShapeZ,
+// btStaticPlaneShape; poses, masses and the principal inertia Impetus has), stepped once with dt.
 //
 // Settings for the impulse problem: contact and friction ERP 0 and split impulse off (so the velocities
 // are the velocity solve's and nothing else), restitution e on every body (Bullet multiplies the two
@@ -9,6 +10,7 @@
 // a box around the cone). The impulse a point applied to body A is p n_B + l1 d1 + l2 d2
 // (btManifoldPoint's applied impulses along its normal and its two lateral directions). Every reset
 // clears the contact manifolds, so no step is warm-started from the previous one.
+#include "bullet_support.hpp"
 #include "peers.hpp"
 
 #include <btBulletDynamicsCommon.h>
@@ -18,13 +20,8 @@
 #include <chrono>
 #include <cmath>
 
-static_assert(sizeof(btScalar) == sizeof(double), "bench_peers needs Bullet's double-precision build");
-
 namespace impetus::peers {
 namespace {
-
-btVector3 to_bt(const Vec3& v) { return btVector3(v.x(), v.y(), v.z()); }
-Vec3 from_bt(const btVector3& v) { return Vec3(v.x(), v.y(), v.z()); }
 
 /// A Bullet solver whose solveGroup calls (setup + iterations + write-back) are timed.
 template <class Solver>
@@ -59,7 +56,7 @@ class BulletStep final : public PeerStep {
  public:
   BulletStep(const bench::PreparedScene& scene, const StepSettings& settings, const BulletConfig& config)
       : scene_(scene), settings_(settings), config_(config), pairs_(scene.contacts),
-        dispatcher_(&collision_config_), sphere_(sphere_radius(scene)) {
+        dispatcher_(&collision_config_) {
     if (config.mlcp) {
       auto solver = std::make_unique<MlcpSolver>(&dantzig_);
       mlcp_ = solver.get();
@@ -92,9 +89,7 @@ class BulletStep final : public PeerStep {
       const RigidBody& b = scene_.bodies[i];
       if (b.fixed) continue;
       btRigidBody& body = *bodies_[i];
-      btTransform pose;
-      pose.setIdentity();
-      pose.setOrigin(to_bt(b.position));
+      const btTransform pose = transform(b);
       body.setWorldTransform(pose);
       body.setInterpolationWorldTransform(pose);
       body.setLinearVelocity(to_bt(b.velocity));
@@ -148,21 +143,23 @@ class BulletStep final : public PeerStep {
     return static_cast<const SiSolver*>(solver_.get())->seconds;
   }
 
+  static btTransform transform(const RigidBody& b) {
+    const Quat q = b.orientation();
+    return btTransform(btQuaternion(q.x(), q.y(), q.z(), q.w()), to_bt(b.position));
+  }
+
   void add_bodies() {
     const double restitution = scene_.bodies.front().material.restitution;
     for (std::size_t i = 0; i < scene_.bodies.size(); ++i) {
       const RigidBody& b = scene_.bodies[i];
+      check_peer_shape(b);
+      shapes_.push_back(make_bullet_shape(b));
       std::unique_ptr<btRigidBody> body;
       if (b.fixed) {
-        const Plane& plane = std::get<Plane>(b.shape);
-        // Both use "solid below the plane, normal pointing out of it": n·p ≤ offset.
-        plane_ = std::make_unique<btStaticPlaneShape>(to_bt(plane.normal), plane.offset);
-        body = std::make_unique<btRigidBody>(btRigidBody::btRigidBodyConstructionInfo(0.0, nullptr, plane_.get()));
+        body = std::make_unique<btRigidBody>(btRigidBody::btRigidBodyConstructionInfo(0.0, nullptr, shapes_.back().get()));
       } else {
-        btVector3 inertia;
-        sphere_.calculateLocalInertia(b.mass, inertia);  // 2/5 m r², as Impetus
-        btRigidBody::btRigidBodyConstructionInfo info(b.mass, nullptr, &sphere_, inertia);
-        info.m_startWorldTransform.setOrigin(to_bt(b.position));
+        btRigidBody::btRigidBodyConstructionInfo info(b.mass, nullptr, shapes_.back().get(), to_bt(principal_inertia(b)));
+        info.m_startWorldTransform = transform(b);
         body = std::make_unique<btRigidBody>(info);
         body->setActivationState(DISABLE_DEACTIVATION);
       }
@@ -188,8 +185,7 @@ class BulletStep final : public PeerStep {
   std::unique_ptr<btConstraintSolver> solver_;
   MlcpSolver* mlcp_ = nullptr;
   std::unique_ptr<btDiscreteDynamicsWorld> world_;
-  btSphereShape sphere_;
-  std::unique_ptr<btStaticPlaneShape> plane_;
+  std::vector<std::unique_ptr<btCollisionShape>> shapes_;  ///< per body
   std::vector<std::unique_ptr<btRigidBody>> bodies_;
   double solver_seconds_before_ = 0.0;
   int fallbacks_before_ = 0;

@@ -1,6 +1,6 @@
 // MuJoCo on the peers' scenes: a model built from an MJCF string (loaded through a virtual file system):
-// one free body per sphere (geom sphere, mass 1, so inertia 2/5 m r² as Impetus), the fixed plane as a
-// world geom, every geom condim = 1 (frictionless; with friction, the "_mu" scenes: condim 3, friction
+// one free body per movable body (a sphere, box or capsule geom; the body's pose, and an explicit
+// inertial with Impetus's mass and principal inertia), each fixed plane a world geom, every geom condim = 1 (frictionless; with friction, the "_mu" scenes: condim 3, friction
 // "μ 0 0" — sliding only — and elliptic cones, or pyramidal ones in the `_pyramidal` rows), Euler
 // integrator, dt, gravity as set; solver PGS, CG or
 // Newton with iterations 100 and tolerance 1e-10. One mj_step from mj_resetData (no warm start).
@@ -17,6 +17,7 @@
 
 #include <mujoco/mujoco.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <sstream>
@@ -38,25 +39,24 @@ struct MujocoConfig {
   bool pyramidal = false;  ///< pyramidal friction cones (MuJoCo's default), else elliptic
 };
 
-std::string vec(const Vec3& v) {
-  std::ostringstream s;
-  s.precision(17);
-  s << v.x() << ' ' << v.y() << ' ' << v.z();
-  return s.str();
-}
-
-/// The scene as MJCF: spheres in Impetus order (body k + 1 is Impetus body k), the plane as world geom 0.
+/// The scene as MJCF: movable bodies in Impetus order (MuJoCo body k + 1 is the k-th movable one), the
+/// fixed planes as world geoms.
 std::string make_mjcf(const bench::PreparedScene& scene, const StepSettings& settings, const MujocoConfig& config) {
   std::ostringstream x;
   x.precision(17);
   // MuJoCo 2.2 allocates dense njmax × nv and njmax × njmax arrays: size them for the contacts the Impetus
-  // detector found (+10 %), not generously, or pyramid 50 cannot allocate its mjData.
+  // detector found (+10 %), not generously, or pyramid 50 cannot allocate its mjData. Spheres touch at one
+  // point; boxes and capsules at up to 4 (8 for two boxes), where Impetus may keep fewer: twice its count.
   // A frictional contact has 3 rows (elliptic cone) or 4 (pyramidal: 2 per tangent direction).
   const std::size_t rows = scene.bodies.front().material.friction > 0 ? 4 : 1;
-  const std::size_t capacity = rows * (scene.contacts.size() + scene.contacts.size() / 10) + 20;
+  const bool spheres = std::all_of(scene.bodies.begin(), scene.bodies.end(), [](const RigidBody& b) {
+    return b.fixed || std::holds_alternative<Sphere>(b.shape);
+  });
+  const std::size_t points = spheres ? scene.contacts.size() + scene.contacts.size() / 10 : 2 * scene.contacts.size();
+  const std::size_t capacity = rows * points + 20;
   x << "<mujoco model=\"peers\">\n"
     << "  <size nconmax=\"" << capacity << "\" njmax=\"" << capacity << "\"/>\n"
-    << "  <option timestep=\"" << settings.dt << "\" gravity=\"" << vec(settings.gravity)
+    << "  <option timestep=\"" << settings.dt << "\" gravity=\"" << mjcf_vec(settings.gravity)
     << "\" integrator=\"Euler\" cone=\"" << (config.pyramidal ? "pyramidal" : "elliptic") << "\"/>\n";
   const double mu = scene.bodies.front().material.friction;  // every body's (bench_scenes.hpp)
   if (mu > 0)
@@ -65,15 +65,17 @@ std::string make_mjcf(const bench::PreparedScene& scene, const StepSettings& set
     x << "  <default><geom condim=\"1\"";
   if (config.stiff) x << " solref=\"0 " << -1.0 / settings.dt << "\" solimp=\"0.9999 0.9999 0.001 0.5 2\"";
   x << "/></default>\n  <worldbody>\n";
-  const double radius = sphere_radius(scene);
-  const Plane& plane = std::get<Plane>(scene.bodies.back().shape);
-  // MuJoCo's plane is the solid below local z = 0: zaxis = n, through the point offset·n.
-  x << "    <geom name=\"fixed\" type=\"plane\" size=\"0 0 1\" pos=\"" << vec(plane.offset * plane.normal)
-    << "\" zaxis=\"" << vec(plane.normal) << "\"/>\n";
-  for (const RigidBody& b : scene.bodies) {
+  for (std::size_t i = 0; i < scene.bodies.size(); ++i) {  // the fixed planes, as world geoms
+    const RigidBody& b = scene.bodies[i];
+    check_peer_shape(b);
+    if (b.fixed) x << "    <geom name=\"g" << i << "\" " << mjcf_geom(b) << "/>\n";
+  }
+  for (std::size_t i = 0; i < scene.bodies.size(); ++i) {
+    const RigidBody& b = scene.bodies[i];
     if (b.fixed) continue;
-    x << "    <body pos=\"" << vec(b.position) << "\"><freejoint/><geom type=\"sphere\" size=\"" << radius
-      << "\" mass=\"" << b.mass << "\"/></body>\n";
+    x << "    <body pos=\"" << mjcf_vec(b.position) << "\" quat=\"" << mjcf_quat(b.rotation)
+      << "\"><freejoint/><inertial pos=\"0 0 0\" mass=\"" << b.mass << "\" diaginertia=\""
+      << mjcf_vec(principal_inertia(b)) << "\"/><geom name=\"g" << i << "\" " << mjcf_geom(b) << "/></body>\n";
   }
   x << "  </worldbody>\n</mujoco>\n";
   return x.str();
@@ -85,6 +87,8 @@ class MujocoStep final : public PeerStep {
       : scene_(scene), settings_(settings), pairs_(scene.contacts) {
     mjcb_time = &steady_seconds;
     model_ = load_mjcf(make_mjcf(scene, settings, config));
+    for (int g = 0; g < model_->ngeom; ++g)  // "g<i>": Impetus body i
+      geom_body_.push_back(static_cast<std::size_t>(std::stoul(model_->names + model_->name_geomadr[g] + 1)));
     model_->opt.solver = config.solver;
     model_->opt.iterations = config.iterations;
     model_->opt.tolerance = config.tolerance;
@@ -102,10 +106,11 @@ class MujocoStep final : public PeerStep {
     std::size_t k = 0;
     for (const RigidBody& b : scene_.bodies) {
       if (b.fixed) continue;
-      // Free joint: linear velocity in the world frame, angular velocity in the body frame (identity here).
+      // Free joint: linear velocity in the world frame, angular velocity in the body frame.
+      const Vec3 local = b.rotation.transpose() * b.angular_velocity;
       for (int a = 0; a < 3; ++a) {
         data_->qvel[6 * k + a] = b.velocity[a];
-        data_->qvel[6 * k + 3 + a] = b.angular_velocity[a];
+        data_->qvel[6 * k + 3 + a] = local[a];
       }
       ++k;
     }
@@ -127,9 +132,13 @@ class MujocoStep final : public PeerStep {
         r.angular_velocity.push_back(Vec3::Zero());
         continue;
       }
-      const mjtNum* v = data_->qvel + 6 * k++;
+      const mjtNum* v = data_->qvel + 6 * k;
+      // The body frame after the step: the rotation about ω over the step leaves ω's direction as it was,
+      // so the new pose maps the body-frame ω to the world frame as the old one would.
+      const mjtNum* q = data_->qpos + 7 * k + 3;
+      ++k;
       r.velocity.push_back(Vec3(v[0], v[1], v[2]));
-      r.angular_velocity.push_back(Vec3(v[3], v[4], v[5]));  // body frame = world frame (identity pose)
+      r.angular_velocity.push_back(Quat(q[0], q[1], q[2], q[3]).normalized() * Vec3(v[3], v[4], v[5]));
     }
     ContactTally tally(pairs_, scene_.contacts, true);
     for (int c = 0; c < data_->ncon; ++c) {
@@ -142,7 +151,7 @@ class MujocoStep final : public PeerStep {
       const Vec3 on_2 = f[0] * Vec3(contact.frame[0], contact.frame[1], contact.frame[2]) +
                         f[1] * Vec3(contact.frame[3], contact.frame[4], contact.frame[5]) +
                         f[2] * Vec3(contact.frame[6], contact.frame[7], contact.frame[8]);
-      tally.add(impetus_body(contact.geom1), impetus_body(contact.geom2), f[0] * settings_.dt,
+      tally.add(geom_body_[static_cast<std::size_t>(contact.geom1)], geom_body_[static_cast<std::size_t>(contact.geom2)], f[0] * settings_.dt,
                 Vec3(settings_.dt * on_2));
     }
     tally.finish(r);
@@ -153,16 +162,12 @@ class MujocoStep final : public PeerStep {
   }
 
  private:
-  std::size_t impetus_body(int geom) const {
-    const int body = model_->geom_bodyid[geom];
-    return body == 0 ? fixed_body(scene_) : static_cast<std::size_t>(body - 1);
-  }
-
   const bench::PreparedScene& scene_;
   StepSettings settings_;
   PairIndex pairs_;
   mjModel* model_ = nullptr;
   mjData* data_ = nullptr;
+  std::vector<std::size_t> geom_body_;  ///< per MuJoCo geom, its Impetus body
   double solver_seconds_ = 0.0;
   long steps_ = 0;
 };

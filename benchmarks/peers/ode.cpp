@@ -1,6 +1,7 @@
 // ODE (double precision: dDOUBLE, checked at start-up with dCheckConfiguration) on the peers' scenes: the
-// same spheres (dMassSetSphereTotal: 2/5 m r²) and planes in a hash space, contact joints made by
-// dCollide in the usual near callback, one dWorldStep (Dantzig LCP) or dWorldQuickStep (projected SOR).
+// same bodies (spheres, boxes, capsules along body z, planes; poses, masses and the principal inertia
+// Impetus has) in a hash space, contact joints made by dCollide (up to 8 points per pair) in the usual
+// near callback, one dWorldStep (Dantzig LCP) or dWorldQuickStep (projected SOR).
 //
 // Settings: world ERP 0 (no Baumgarte velocity) unless a row says otherwise, contact surface layer 0,
 // bounce = e with bounce_vel 0 for e > 0, world CFM as configured (contacts use it: no dContactSoftCFM).
@@ -56,12 +57,13 @@ class OdeStep final : public PeerStep {
     dJointGroupEmpty(joints_);
     feedback_.clear();
     contact_pairs_.clear();
-    const dQuaternion identity = {1, 0, 0, 0};
     for (std::size_t i = 0; i < bodies_.size(); ++i) {
       const RigidBody& b = scene_.bodies[i];
       if (!bodies_[i]) continue;
       dBodySetPosition(bodies_[i], b.position.x(), b.position.y(), b.position.z());
-      dBodySetQuaternion(bodies_[i], identity);
+      const Quat q = b.orientation();
+      const dQuaternion orientation = {q.w(), q.x(), q.y(), q.z()};
+      dBodySetQuaternion(bodies_[i], orientation);
       dBodySetLinearVel(bodies_[i], b.velocity.x(), b.velocity.y(), b.velocity.z());
       dBodySetAngularVel(bodies_[i], b.angular_velocity.x(), b.angular_velocity.y(), b.angular_velocity.z());
       dBodySetForce(bodies_[i], 0, 0, 0);
@@ -91,8 +93,8 @@ class OdeStep final : public PeerStep {
     }
     ContactTally tally(pairs_, scene_.contacts, true);
     for (std::size_t k = 0; k < feedback_.size(); ++k) {
-      // Body 1 is always the sphere (near_callback orders the geoms) and the normal points into it, so
-      // the force ODE applied to body 1 along the normal, times dt, is the contact's impulse.
+      // Body 1 is never a plane (near_callback orders the geoms) and the normal points into it, so the
+      // force ODE applied to body 1 along the normal, times dt, is the contact's impulse.
       const ContactPair& c = contact_pairs_[k];
       const dReal* f = feedback_[k].f1;
       tally.add(c.i, c.j, (f[0] * c.normal.x() + f[1] * c.normal.y() + f[2] * c.normal.z()) * settings_.dt,
@@ -115,9 +117,10 @@ class OdeStep final : public PeerStep {
 
   static void near_callback(void* data, dGeomID g1, dGeomID g2) {
     auto& self = *static_cast<OdeStep*>(data);
-    if (!dGeomGetBody(g1)) std::swap(g1, g2);  // the plane (no body) second
-    dContact contacts[4];
-    const int n = dCollide(g1, g2, 4, &contacts[0].geom, sizeof(dContact));
+    if (!dGeomGetBody(g1)) std::swap(g1, g2);  // a plane (no body) second
+    if (!dGeomGetBody(g1)) return;             // two planes
+    dContact contacts[8];
+    const int n = dCollide(g1, g2, 8, &contacts[0].geom, sizeof(dContact));
     for (int k = 0; k < n; ++k) {
       dContact& c = contacts[k];
       c.surface.mode = (self.restitution_ > 0 ? dContactBounce : 0) | (self.friction_ > 0 ? dContactApprox1 : 0);
@@ -135,21 +138,17 @@ class OdeStep final : public PeerStep {
   void add_bodies() {
     restitution_ = scene_.bodies.front().material.restitution;
     friction_ = scene_.bodies.front().material.friction;  // every body's (bench_scenes.hpp)
-    const double radius = sphere_radius(scene_);
     for (std::size_t i = 0; i < scene_.bodies.size(); ++i) {
       const RigidBody& b = scene_.bodies[i];
-      dGeomID geom = nullptr;
+      check_peer_shape(b);
+      dGeomID geom = make_ode_geom(space_, b);
       dBodyID body = nullptr;
-      if (b.fixed) {
-        const Plane& plane = std::get<Plane>(b.shape);
-        // ODE's plane a x + b y + c z = d bounds the solid below it, as Impetus's n·p ≤ offset.
-        geom = dCreatePlane(space_, plane.normal.x(), plane.normal.y(), plane.normal.z(), plane.offset);
-      } else {
+      if (!b.fixed) {
         body = dBodyCreate(world_);
         dMass mass;
-        dMassSetSphereTotal(&mass, b.mass, radius);
+        const Vec3 inertia = principal_inertia(b);
+        dMassSetParameters(&mass, b.mass, 0, 0, 0, inertia.x(), inertia.y(), inertia.z(), 0, 0, 0);
         dBodySetMass(body, &mass);
-        geom = dCreateSphere(space_, radius);
         dGeomSetBody(geom, body);
       }
       dGeomSetData(geom, reinterpret_cast<void*>(static_cast<std::uintptr_t>(i)));
@@ -165,7 +164,7 @@ class OdeStep final : public PeerStep {
   dWorldID world_;
   dSpaceID space_;
   dJointGroupID joints_;
-  std::vector<dBodyID> bodies_;             ///< per Impetus body; null for the fixed plane
+  std::vector<dBodyID> bodies_;             ///< per Impetus body; null for a fixed plane
   std::deque<dJointFeedback> feedback_;     ///< per contact joint (a deque: ODE keeps pointers into it)
   std::vector<ContactPair> contact_pairs_;  ///< per contact joint
   double restitution_ = 0.0, friction_ = 0.0;

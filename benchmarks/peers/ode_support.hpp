@@ -2,13 +2,17 @@
 /// \file
 /// ODE set-up shared by bench_peers (ode.cpp) and bench_accuracy_peers (accuracy/ode_world.cpp): one-time
 /// initialization in double precision and a message handler that counts ODE's messages (not errors),
-/// among them the Dantzig LCP's "LCP internal error, s <= 0": ODE's only report that dWorldStep gave up.
+/// among them the Dantzig LCP's "LCP internal error, s <= 0": ODE's only report that dWorldStep gave up;
+/// and the geom of a body.
+
+#include "impetus/core/body.hpp"
 
 #include <ode/ode.h>
 
 #include <cstdarg>
 #include <cstdio>
 #include <cstdlib>
+#include <variant>
 
 namespace impetus::peers {
 
@@ -35,6 +39,18 @@ inline void init_ode() {
     return true;
   }();
   (void)done;
+}
+
+/// The geom of a body in `space`, in the body frame (a capsule and a cylinder along local z, as Impetus's;
+/// a box by its full edge lengths). A mesh is refused before (the callers check the shapes).
+inline dGeomID make_ode_geom(dSpaceID space, const RigidBody& b) {
+  if (const auto* s = std::get_if<Sphere>(&b.shape)) return dCreateSphere(space, s->radius);
+  if (const auto* s = std::get_if<Box>(&b.shape)) return dCreateBox(space, s->size.x(), s->size.y(), s->size.z());
+  if (const auto* s = std::get_if<Capsule>(&b.shape)) return dCreateCapsule(space, s->radius, s->length);
+  if (const auto* s = std::get_if<Cylinder>(&b.shape)) return dCreateCylinder(space, s->radius, s->length);
+  const Plane& p = std::get<Plane>(b.shape);
+  // ODE's plane a x + b y + c z = d bounds the solid below it, as Impetus's n·p ≤ offset.
+  return dCreatePlane(space, p.normal.x(), p.normal.y(), p.normal.z(), p.offset);
 }
 
 }  // namespace impetus::peers

@@ -11,8 +11,10 @@
 #include <functional>
 #include <limits>
 #include <memory>
+#include <stdexcept>
 #include <string>
 #include <unordered_map>
+#include <variant>
 #include <vector>
 
 namespace impetus::peers {
@@ -84,8 +86,9 @@ std::string bullet_description();
 std::string ode_description();
 std::string mujoco_description();
 
-/// Finds the Impetus contact on an unordered pair of Impetus bodies (each pair of spheres, or a sphere
-/// and a plane, touches at one point in these scenes).
+/// Finds the Impetus contact on an unordered pair of Impetus bodies: the first of the pair's contacts
+/// (a box or a capsule may touch another body at several points; report() in main.cpp judges such a
+/// pair by the sum of the impulses on it).
 class PairIndex {
  public:
   explicit PairIndex(const std::vector<Contact>& contacts) {
@@ -130,7 +133,8 @@ class ContactTally {
   void finish(StepResult& out) {
     out.engine_contacts = points_;
     out.extra = extra_;
-    out.matched = static_cast<std::size_t>(std::count(hit_.begin(), hit_.end(), true));
+    out.matched = 0;  // every contact of a pair the engine touched (PairIndex marks the pair's first)
+    for (const Contact& c : contacts_) out.matched += hit_[static_cast<std::size_t>(pairs_.find(c.a, c.b))] ? 1 : 0;
     if (known_) out.impulses = std::move(impulses_);
     if (known_ && vectors_known_) out.impulse_vectors = std::move(vectors_);
   }
@@ -157,12 +161,19 @@ class ContactTally {
   std::size_t points_ = 0, extra_ = 0;
 };
 
-/// Index of the scene's single fixed body (ground or wall, last in PreparedScene::bodies).
-inline std::size_t fixed_body(const bench::PreparedScene& scene) { return scene.bodies.size() - 1; }
-
-/// Sphere radius and mass of the scene (all spheres are equal in the benchmark scenes).
-inline double sphere_radius(const bench::PreparedScene& scene) {
-  return std::get<Sphere>(scene.bodies.front().shape).radius;
+/// The shapes the engines are given: a fixed body must be a plane, a movable one a sphere, a box, a capsule
+/// or a cylinder (primitives every engine has with the same geometry: a capsule is a segment along body z
+/// swept by a sphere). Throws std::invalid_argument naming the body otherwise.
+inline void check_peer_shape(const RigidBody& b) {
+  const bool ok = b.fixed ? std::holds_alternative<Plane>(b.shape)
+                          : !std::holds_alternative<Plane>(b.shape) && !std::holds_alternative<MeshShape>(b.shape);
+  if (!ok)
+    throw std::invalid_argument("body '" + b.name +
+                                "': the peers take fixed planes and movable spheres, boxes, capsules and cylinders");
 }
+
+/// The principal moments of inertia of a movable body (kg·m²): the body frame of every primitive is
+/// principal, so each engine gets Impetus's own inertia rather than recomputing it.
+inline Vec3 principal_inertia(const RigidBody& b) { return b.inertia_body.diagonal(); }
 
 }  // namespace impetus::peers

@@ -16,18 +16,17 @@
 // iteration count.
 #include "peer_world.hpp"
 
+#include "../bullet_support.hpp"
+
 #include <btBulletDynamicsCommon.h>
 
 #include <cmath>
 #include <variant>
 
-static_assert(sizeof(btScalar) == sizeof(double), "bench_accuracy_peers needs Bullet's double-precision build");
-
 namespace impetus::peers::accuracy {
 namespace {
 
-btVector3 to_bt(const Vec3& v) { return btVector3(v.x(), v.y(), v.z()); }
-Vec3 from_bt(const btVector3& v) { return Vec3(v.x(), v.y(), v.z()); }
+using peers::from_bt;  // beside the overload for matrices below
 btMatrix3x3 to_bt_matrix(const Mat3& m) {
   return btMatrix3x3(m(0, 0), m(0, 1), m(0, 2), m(1, 0), m(1, 1), m(1, 2), m(2, 0), m(2, 1), m(2, 2));
 }
@@ -100,21 +99,9 @@ class BulletWorld final : public PeerWorld {
   }
 
  private:
-  std::unique_ptr<btCollisionShape> make_shape(const RigidBody& b, bool no_contacts) {
+  static std::unique_ptr<btCollisionShape> make_shape(const RigidBody& b, bool no_contacts) {
     if (no_contacts) return std::make_unique<btSphereShape>(0.1);  // never touches anything
-    if (const auto* s = std::get_if<Sphere>(&b.shape)) return std::make_unique<btSphereShape>(s->radius);
-    if (const auto* s = std::get_if<Box>(&b.shape)) {
-      auto box = std::make_unique<btBoxShape>(to_bt(Vec3(0.5 * s->size)));
-      // The margin lies inside the box; a thin box (the plank) needs a smaller one than the default 4 cm.
-      box->setMargin(std::min(box->getMargin(), 0.2 * 0.5 * s->size.minCoeff()));
-      return box;
-    }
-    if (const auto* s = std::get_if<Capsule>(&b.shape)) return std::make_unique<btCapsuleShapeZ>(s->radius, s->length);
-    if (const auto* s = std::get_if<Cylinder>(&b.shape))
-      return std::make_unique<btCylinderShapeZ>(btVector3(s->radius, s->radius, 0.5 * s->length));
-    const Plane& p = std::get<Plane>(b.shape);  // meshes are refused before (first_mesh)
-    // Both mean the solid n·x ≤ offset with the normal pointing out of it.
-    return std::make_unique<btStaticPlaneShape>(to_bt(p.normal), p.offset);
+    return make_bullet_shape(b);
   }
 
   void add_body(const PeerScene& scene, std::size_t i, double restitution, bool no_contacts) {

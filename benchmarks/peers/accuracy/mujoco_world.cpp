@@ -21,41 +21,6 @@
 namespace impetus::peers::accuracy {
 namespace {
 
-std::string vec(const Vec3& v) {
-  std::ostringstream s;
-  s.precision(17);
-  s << v.x() << ' ' << v.y() << ' ' << v.z();
-  return s.str();
-}
-
-std::string quat(const Mat3& r) {
-  const Quat q = Quat(r).normalized();
-  std::ostringstream s;
-  s.precision(17);
-  s << q.w() << ' ' << q.x() << ' ' << q.y() << ' ' << q.z();
-  return s.str();
-}
-
-/// The geom of body i as MJCF attributes (type, size), in the body frame.
-std::string geom(const RigidBody& b) {
-  std::ostringstream x;
-  x.precision(17);
-  if (const auto* s = std::get_if<Sphere>(&b.shape)) {
-    x << "type=\"sphere\" size=\"" << s->radius << "\"";
-  } else if (const auto* s = std::get_if<Box>(&b.shape)) {
-    x << "type=\"box\" size=\"" << vec(0.5 * s->size) << "\"";
-  } else if (const auto* s = std::get_if<Capsule>(&b.shape)) {
-    x << "type=\"capsule\" size=\"" << s->radius << ' ' << 0.5 * s->length << "\"";
-  } else if (const auto* s = std::get_if<Cylinder>(&b.shape)) {
-    x << "type=\"cylinder\" size=\"" << s->radius << ' ' << 0.5 * s->length << "\"";
-  } else {
-    const Plane& p = std::get<Plane>(b.shape);  // meshes are refused before (first_mesh)
-    // MuJoCo's plane is the solid below its local z = 0: zaxis = n, through the point offset·n.
-    x << "type=\"plane\" size=\"0 0 1\" pos=\"" << vec(p.offset * p.normal) << "\" zaxis=\"" << vec(p.normal) << "\"";
-  }
-  return x.str();
-}
-
 /// The one μ of every body that may touch another (mujoco_unsupported refuses a scene with several).
 double scene_friction(const PeerScene& scene) {
   for (std::size_t i = 0; i < scene.bodies.size(); ++i)
@@ -75,7 +40,7 @@ std::string make_mjcf(const PeerScene& scene, int solver) {
   x.precision(17);
   x << "<mujoco model=\"accuracy\">\n"
     << "  <size nconmax=\"" << capacity << "\" njmax=\"" << capacity << "\"/>\n"
-    << "  <option timestep=\"" << scene.settings.dt << "\" gravity=\"" << vec(scene.settings.gravity)
+    << "  <option timestep=\"" << scene.settings.dt << "\" gravity=\"" << mjcf_vec(scene.settings.gravity)
     << "\" integrator=\"Euler\" solver=\"" << (solver == mjSOL_PGS ? "PGS" : "Newton")
     << "\" iterations=\"100\" tolerance=\"1e-10\"" << (mu > 0 ? " cone=\"elliptic\"" : "") << "/>\n"
     << "  <default><geom condim=\"" << (mu > 0 ? 3 : 1) << "\" friction=\"" << mu << " 0 0\" contype=\""
@@ -83,19 +48,19 @@ std::string make_mjcf(const PeerScene& scene, int solver) {
   for (std::size_t i = 0; i < scene.bodies.size(); ++i) {
     const RigidBody& b = scene.bodies[i];
     if (!b.fixed) continue;
-    x << "    <geom name=\"g" << i << "\" " << geom(b);
+    x << "    <geom name=\"g" << i << "\" " << mjcf_geom(b);
     if (!std::holds_alternative<Plane>(b.shape))
-      x << " pos=\"" << vec(b.position) << "\" quat=\"" << quat(b.rotation) << "\"";
+      x << " pos=\"" << mjcf_vec(b.position) << "\" quat=\"" << mjcf_quat(b.rotation) << "\"";
     x << "/>\n";
   }
   for (std::size_t i = 0; i < scene.bodies.size(); ++i) {
     const RigidBody& b = scene.bodies[i];
     if (b.fixed) continue;
     const Mat3& j = b.inertia_body;
-    x << "    <body name=\"b" << i << "\" pos=\"" << vec(b.position) << "\" quat=\"" << quat(b.rotation)
+    x << "    <body name=\"b" << i << "\" pos=\"" << mjcf_vec(b.position) << "\" quat=\"" << mjcf_quat(b.rotation)
       << "\"><freejoint/><inertial pos=\"0 0 0\" mass=\"" << b.mass << "\" fullinertia=\"" << j(0, 0) << ' '
       << j(1, 1) << ' ' << j(2, 2) << ' ' << j(0, 1) << ' ' << j(0, 2) << ' ' << j(1, 2) << "\"/>";
-    if (!no_contacts) x << "<geom name=\"g" << i << "\" " << geom(b) << "/>";
+    if (!no_contacts) x << "<geom name=\"g" << i << "\" " << mjcf_geom(b) << "/>";
     x << "</body>\n";
   }
   x << "  </worldbody>\n";
@@ -110,7 +75,7 @@ std::string make_mjcf(const PeerScene& scene, int solver) {
       const bool swap = scene.bodies[pp.a].fixed;
       const BodyIndex first = swap ? pp.b : pp.a, second = swap ? pp.a : pp.b;
       x << "    <connect body1=\"" << body_name(first) << "\" body2=\"" << body_name(second) << "\" anchor=\""
-        << vec(swap ? pp.anchor_b : pp.anchor_a) << "\"/>\n";
+        << mjcf_vec(swap ? pp.anchor_b : pp.anchor_a) << "\"/>\n";
     }
     x << "  </equality>\n";
   }

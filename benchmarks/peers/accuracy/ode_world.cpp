@@ -142,16 +142,6 @@ class OdeWorld final : public PeerWorld {
     }
   }
 
-  dGeomID make_geom(const RigidBody& b) {
-    if (const auto* s = std::get_if<Sphere>(&b.shape)) return dCreateSphere(space_, s->radius);
-    if (const auto* s = std::get_if<Box>(&b.shape)) return dCreateBox(space_, s->size.x(), s->size.y(), s->size.z());
-    if (const auto* s = std::get_if<Capsule>(&b.shape)) return dCreateCapsule(space_, s->radius, s->length);
-    if (const auto* s = std::get_if<Cylinder>(&b.shape)) return dCreateCylinder(space_, s->radius, s->length);
-    const Plane& p = std::get<Plane>(b.shape);  // meshes are refused before (first_mesh)
-    // ODE's plane a x + b y + c z = d bounds the solid below it, as Impetus's n·p ≤ offset.
-    return dCreatePlane(space_, p.normal.x(), p.normal.y(), p.normal.z(), p.offset);
-  }
-
   void add_body(const RigidBody& b, std::size_t i, bool no_contacts) {
     dBodyID body = nullptr;
     dMatrix3 rotation;
@@ -170,7 +160,7 @@ class OdeWorld final : public PeerWorld {
     }
     bodies_.push_back(body);
     if (no_contacts) return;
-    const dGeomID geom = make_geom(b);
+    const dGeomID geom = make_ode_geom(space_, b);
     dGeomSetData(geom, reinterpret_cast<void*>(static_cast<std::uintptr_t>(i)));
     if (body) {
       dGeomSetBody(geom, body);
