@@ -333,6 +333,32 @@ TEST(MirtichFriction, TurningSlipIntegrationIsConverged) {
   std::printf("[ mirtich friction ] turning slip: largest change with a 100x tighter tolerance %.3e\n", largest);
 }
 
+// A collision recorded from the pile of 1,000 primitives at μ = 0.5 (a box's corner on a capsule, e = 0):
+// its slip spirals into zero, the direction turning ever faster, and before the slip's stall rule it sat
+// at 3e-12 of the impact speed until the 20,000 steps ran out (43,410 such collisions made one step of
+// the pile take 5 minutes). It must end, stuck, in a few thousand steps at most, as the instantaneous
+// model says (sticking is inside the cone: u⁺ = 0 with ‖p_t‖ ≤ μ p_n), and agree with it to the
+// integration's tolerance.
+TEST(MirtichFriction, SlipSpirallingIntoZeroEndsStuck) {
+  Mat3 k;
+  k << 1.4450889470163437, 0.36245674839213282, 0.13026579052654894,  //
+      0.36245674839213282, 0.80143577088779039, -0.2898679416413254,  //
+      0.13026579052654891, -0.28986794164132534, 0.78185851709368559;
+  const Vec3 u(-0.021151607067290995, -0.040807008194839622, 0.065646666452352731);
+  const Vec3 n(0.0, 0.0, -1.0);
+  const double mu = 0.5;
+  const mirtich::FrictionalImpact impact = mirtich::integrate_frictional_impact(k, u, n, mu, 0.0);
+  ASSERT_TRUE(impact.converged) << impact.steps << " steps";
+  EXPECT_TRUE(impact.stuck);
+  EXPECT_LT(impact.steps, 5000u);
+  const Vec3 p = impact.impulse(n);
+  EXPECT_LT((u + k * p).norm(), 1e-9 * u.norm());  // stuck with e = 0: the contact point stops
+  EXPECT_LE(impact.tangent_impulse.norm(), mu * impact.normal_impulse * (1 + 1e-12));
+  const std::optional<Vec3> instantaneous = instantaneous_coulomb(k, u, n, mu);
+  ASSERT_TRUE(instantaneous.has_value());
+  EXPECT_LT((u + k * *instantaneous).norm(), 1e-12 * u.norm());  // the model sticks too
+}
+
 // Kane's example: a slender rod (1 m × 2 cm × 2 cm, 1 kg) at 45° in the xz plane hits the ground with
 // its lower end, moving obliquely and spinning. With Stronge's coefficient the collision never gains
 // kinetic energy (after ≤ before × (1 + 1e-12)) for μ = 0.5 and 1, e = 0.5 and 1, several spins; with
