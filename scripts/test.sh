@@ -2,7 +2,7 @@
 # Quick start, command 2: install the dependencies, build everything, and run the whole test suite —
 # three times over:
 #   1. as built (build/, or $IMPETUS_BUILD_DIR);
-#   2. again under AddressSanitizer + UndefinedBehaviorSanitizer (build-asan/, IMPETUS_SANITIZE=ON):
+#   2. again under AddressSanitizer + UndefinedBehaviorSanitizer (build-asan/, IMPETUS_SANITIZE=ON, -O1 -g1):
 #      any report fails the run (halt_on_error, leaks included);
 #   3. a bounded fuzz run: every libFuzzer target for $IMPETUS_FUZZ_SECONDS (default 60) seconds from its
 #      seed corpus and kept regressions (scripts/fuzz.sh; clang, build-fuzz/ or $IMPETUS_FUZZ_BUILD_DIR).

@@ -294,9 +294,6 @@ void register_all() {
       const std::string family = scene.family, mu = scene.mu;
       const int n = scene.n;
       if (static_cast<std::size_t>(n) > std::min(max_bodies, method.max_bodies)) continue;
-      // mirtich with friction on the pile: one step took 399 s (2026-12-04: 43,410 rows at its impulse
-      // cap), so the frictional rows leave it out.
-      if (!mu.empty() && method.name == "impetus_mirtich_step") continue;
       const std::string key = family + "_" + std::to_string(n) + (mu.empty() ? "" : "_mu" + mu);
       benchmark::RegisterBenchmark(("peers/" + method.name + "_gravity/" + key).c_str(),
                                    [&method, gravity, family, n, mu](benchmark::State& st) {
