@@ -156,9 +156,11 @@ class BulletStep final : public PeerStep {
       shapes_.push_back(make_bullet_shape(b));
       std::unique_ptr<btRigidBody> body;
       if (b.fixed) {
-        body = std::make_unique<btRigidBody>(btRigidBody::btRigidBodyConstructionInfo(0.0, nullptr, shapes_.back().get()));
+        body = std::make_unique<btRigidBody>(
+            btRigidBody::btRigidBodyConstructionInfo(0.0, nullptr, shapes_.back().get()));
       } else {
-        btRigidBody::btRigidBodyConstructionInfo info(b.mass, nullptr, shapes_.back().get(), to_bt(principal_inertia(b)));
+        btRigidBody::btRigidBodyConstructionInfo info(b.mass, nullptr, shapes_.back().get(),
+                                                      to_bt(principal_inertia(b)));
         info.m_startWorldTransform = transform(b);
         body = std::make_unique<btRigidBody>(info);
         body->setActivationState(DISABLE_DEACTIVATION);

@@ -57,10 +57,12 @@ class ImpetusStep final : public PeerStep {
 /// the velocities their solve left on the snapshot's contacts, so the Impetus row reports these.
 class SolvedVelocities final : public Integrator {
  public:
-  void integrate_velocities(std::span<RigidBody> bodies, const StepContext& ctx, IntegratorCounters& counters) noexcept override {
+  void integrate_velocities(std::span<RigidBody> bodies, const StepContext& ctx,
+                            IntegratorCounters& counters) noexcept override {
     inner_.integrate_velocities(bodies, ctx, counters);
   }
-  void integrate_positions(std::span<RigidBody> bodies, const StepContext& ctx, IntegratorCounters& counters) noexcept override {
+  void integrate_positions(std::span<RigidBody> bodies, const StepContext& ctx,
+                           IntegratorCounters& counters) noexcept override {
     velocity.resize(bodies.size());
     angular_velocity.resize(bodies.size());
     for (std::size_t i = 0; i < bodies.size(); ++i) {

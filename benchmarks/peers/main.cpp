@@ -127,7 +127,8 @@ ContactJudgement judge_contacts(std::span<const RigidBody> after, const std::vec
       it->second.second = std::min(it->second.second, velocity(c) - c.depth / dt);
   if (impulses.empty()) return j;
   j.complementarity = 0.0;
-  for (const auto& [pair, judged] : pairs) j.complementarity = std::max(j.complementarity, std::abs(judged.first * judged.second));
+  for (const auto& [pair, judged] : pairs)
+    j.complementarity = std::max(j.complementarity, std::abs(judged.first * judged.second));
   return j;
 }
 
@@ -144,7 +145,8 @@ void report(benchmark::State& state, const bench::PreparedScene& prepared, const
   }
   const bool have_impulses = !r.impulses.empty();
   const bench::Quality q = bench::measure_quality(after, prepared.bodies, prepared.contacts, {});  // the energy
-  const ContactJudgement judged = judge_contacts(after, prepared.contacts, speculative_contacts(prepared), r.impulses, settings.dt);
+  const ContactJudgement judged =
+      judge_contacts(after, prepared.contacts, speculative_contacts(prepared), r.impulses, settings.dt);
   // For e = 1 the exact answer has p·v⁺ ≠ 0, so complementarity is not a failure measure there.
   const double complementarity = have_impulses && inelastic ? judged.complementarity : kNaN;
   state.counters["bodies"] = static_cast<double>(prepared.movable);
@@ -282,8 +284,9 @@ void register_all() {
     }
     if (!kDynamicMethods.contains(method.name)) continue;
     // The wall of 1,000 bricks is left out: its 20 lead-in steps take Impetus minutes (bench_step has
-    // the wall of 200 for the same reason). With friction: the heap (spheres: one point per pair, so fclib's natural map is measured) and the
-    // pile (a box's points differ between engines: judged by the normal conditions only).
+    // the wall of 200 for the same reason). With friction: the heap (spheres: one point per pair, so
+    // fclib's natural map is measured) and the pile (a box's points differ between engines: judged by
+    // the normal conditions only).
     const struct {
       const char* family;
       int n;

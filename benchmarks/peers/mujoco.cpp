@@ -151,8 +151,9 @@ class MujocoStep final : public PeerStep {
       const Vec3 on_2 = f[0] * Vec3(contact.frame[0], contact.frame[1], contact.frame[2]) +
                         f[1] * Vec3(contact.frame[3], contact.frame[4], contact.frame[5]) +
                         f[2] * Vec3(contact.frame[6], contact.frame[7], contact.frame[8]);
-      tally.add(geom_body_[static_cast<std::size_t>(contact.geom1)], geom_body_[static_cast<std::size_t>(contact.geom2)], f[0] * settings_.dt,
-                Vec3(settings_.dt * on_2));
+      const std::size_t body_1 = geom_body_[static_cast<std::size_t>(contact.geom1)];
+      const std::size_t body_2 = geom_body_[static_cast<std::size_t>(contact.geom2)];
+      tally.add(body_1, body_2, f[0] * settings_.dt, Vec3(settings_.dt * on_2));
     }
     tally.finish(r);
     r.iterations = data_->solver_iter;
