@@ -4,7 +4,7 @@
 #   1. as built (build/, or $IMPETUS_BUILD_DIR);
 #   2. again under AddressSanitizer + UndefinedBehaviorSanitizer (build-asan/, IMPETUS_SANITIZE=ON, -O1 -g1):
 #      any report fails the run (halt_on_error, leaks included);
-#   3. a bounded fuzz run: every libFuzzer target for $IMPETUS_FUZZ_SECONDS (default 60) seconds from its
+#   3. a bounded fuzz run: every libFuzzer target for $IMPETUS_FUZZ_SECONDS (default 30) seconds from its
 #      seed corpus and kept regressions (scripts/fuzz.sh; clang, build-fuzz/ or $IMPETUS_FUZZ_BUILD_DIR).
 # Extra arguments go to ctest in both test passes (e.g. -R Cli). IMPETUS_SANITIZE_TESTS=0 skips pass 2,
 # IMPETUS_FUZZ_SECONDS=0 skips pass 3.
@@ -30,8 +30,8 @@ if [ "${IMPETUS_SANITIZE_TESTS:-1}" != "0" ]; then
   echo "test.sh: sanitizer pass: build $(( built - start )) s, tests $(( $(date +%s) - built )) s"
 fi
 
-if [ "${IMPETUS_FUZZ_SECONDS:-60}" != "0" ]; then
+if [ "${IMPETUS_FUZZ_SECONDS:-30}" != "0" ]; then
   # Every target, the mesh formats included: assimp runs in its own process (assets/README.md), so an
   # input that crashes assimp is a clear error, not a crash of the fuzzer. 9 targets, $(nproc) at a time.
-  "$root/scripts/fuzz.sh" --time "${IMPETUS_FUZZ_SECONDS:-60}"
+  "$root/scripts/fuzz.sh" --time "${IMPETUS_FUZZ_SECONDS:-30}"
 fi
