@@ -17,8 +17,8 @@ if(CMAKE_CXX_COMPILER_ID MATCHES "GNU|Clang")
   endif()
   if(IMPETUS_SANITIZE)
     # -O1 -g1 (after the build type's flags, so they win): the sanitizers' usual level, with line tables
-    # for the reports' stacks but no variable info. It builds in about 0.6x the time of -O2 -g, which
-    # keeps the test command's second pass short.
+    # for the reports' stacks but no variable info. The heaviest file builds in 0.6x the time it takes
+    # at -O2 -g, which keeps the test command's second pass short.
     target_compile_options(impetus_compile_options INTERFACE
       $<BUILD_INTERFACE:-fsanitize=address,undefined -fno-omit-frame-pointer -fno-sanitize-recover=undefined
                         -O1 -g1>)

@@ -290,6 +290,8 @@ class ImpactIntegrator {
   // it holds to the end of the collision. Otherwise the slip restarts along the invariant direction
   // that diverges from zero.
   void on_slip_zero() {
+    stall_mark_ = kInfinity;  // a slip that restarts is watched afresh (slip_stalls)
+    stall_steps_ = 0;
     const double det = ktt_.determinant();
     const Vec2 d_t = -Vec2(ktt_(1, 1) * ktn_.x() - ktt_(0, 1) * ktn_.y(),
                            -ktt_(1, 0) * ktn_.x() + ktt_(0, 0) * ktn_.y()) / det;
