@@ -1,6 +1,6 @@
 // Bullet (double-precision build, BT_USE_DOUBLE_PRECISION from pkg-config bullet-float64) on the peers'
-// scenes: a btDiscreteDynamicsWorld with the same bodies (btSphereShape, btBoxShape, btCapsuleShapeZ,
-// btStaticPlaneShape; poses, masses and the principal inertia Impetus has), stepped once with dt.
+// scenes: a btDiscreteDynamicsWorld with the same bodies (make_bullet_shape in bullet_support.hpp; poses,
+// masses and the principal inertia Impetus has), stepped once with dt.
 //
 // Settings for the impulse problem: contact and friction ERP 0 and split impulse off (so the velocities
 // are the velocity solve's and nothing else), restitution e on every body (Bullet multiplies the two

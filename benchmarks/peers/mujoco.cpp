@@ -1,6 +1,7 @@
 // MuJoCo on the peers' scenes: a model built from an MJCF string (loaded through a virtual file system):
-// one free body per movable body (a sphere, box or capsule geom; the body's pose, and an explicit
-// inertial with Impetus's mass and principal inertia), each fixed plane a world geom, every geom condim = 1 (frictionless; with friction, the "_mu" scenes: condim 3, friction
+// one free body per movable body (a sphere, box, capsule or cylinder geom; the body's pose, and an
+// explicit inertial with Impetus's mass and principal inertia), each fixed plane a world geom, every
+// geom condim = 1 (frictionless; with friction, the "_mu" scenes: condim 3, friction
 // "μ 0 0" — sliding only — and elliptic cones, or pyramidal ones in the `_pyramidal` rows), Euler
 // integrator, dt, gravity as set; solver PGS, CG or
 // Newton with iterations 100 and tolerance 1e-10. One mj_step from mj_resetData (no warm start).
