@@ -200,7 +200,8 @@ struct ComplementaritySolver::Search {
 // Its free rows F are solved as equalities by one exact solve ((A + εI)_FF is positive definite: no
 // rank test, no null space). Its active set: block principal pivoting (Júdice & Pires: every infeasible
 // row exchanged at once — free rows with a negative impulse leave F, rows at zero that would approach
-// join it) while the number of infeasible rows falls; then the primal active-set method from p = 0 (an
+// join it) while the number of infeasible rows falls; then the primal active-set method from p = 0, or
+// in a later outer iteration from the last subproblem's solution p̄ (an
 // infeasible minimizer is approached until the first free row reaches zero, the rows at zero are
 // released; a feasible one becomes p and the rows approaching fastest join), whose objective strictly
 // decreases between feasible minimizers, so it terminates.
@@ -302,8 +303,16 @@ void ComplementaritySolver::iterate(Search& s, std::uint64_t iteration, SolverSt
     s.exchange(roundoff, stats);
     return;
   }
-  if (s.pivoting && negatives + approaches > 0) {  // pivoting stopped helping: the primal method from p = 0
+  if (s.pivoting && negatives + approaches > 0) {  // pivoting stopped helping: the primal method
     s.pivoting = false;
+    if (s.center.any()) {
+      // From p̄, the last subproblem's solution (p̄ ≥ 0: feasible), with its support free: most of its
+      // rows stay free, where from p = 0 the method would join them again a few at a time.
+      s.p = s.center;
+      for (std::size_t k = 0; k < s.free_rows.size(); ++k)
+        s.free_rows[k] = s.problem.equality[k] || s.p(static_cast<Eigen::Index>(k)) > 0.0;
+      return;
+    }
     s.p.setZero();
   }
   if (negatives > 0) {
