@@ -62,6 +62,13 @@ struct FrictionalWorkspace::Newton {
   std::vector<Linearization> lin, lin_trial;
   Eigen::MatrixXd jacobian;  // the dense path's
   Eigen::PartialPivLU<Eigen::MatrixXd> lu;
+  // The sparse path's: the Jacobian's entries, the Jacobian on the pattern of W + I (every piece's
+  // entries lie in it: a contact's rows share W's pattern), and its LU, whose ordering and symbolic
+  // analysis are kept while W's pattern (`analysed_outer`, `analysed_inner`) does not change.
+  std::vector<Eigen::Triplet<double>> entries;
+  SparseMatrix sparse_jacobian;
+  Eigen::SparseLU<SparseMatrix, Eigen::COLAMDOrdering<int>> sparse_lu;
+  std::vector<SparseMatrix::StorageIndex> analysed_outer, analysed_inner;
 };
 
 FrictionalWorkspace::FrictionalWorkspace() = default;
@@ -259,17 +266,38 @@ bool newton_direction(const std::vector<Block>& blocks, const std::vector<Linear
     d.noalias() = buffers.lu.solve(f);
     d = -d;
   } else {
-    std::vector<Eigen::Triplet<double>> entries;
-    entries.reserve(static_cast<std::size_t>(w.nonZeros()) * 2 + static_cast<std::size_t>(m) * 4);
+    // The Jacobian on the fixed pattern of W + I (explicit zeros where this linearization has none), so
+    // that one ordering and symbolic analysis serve every Newton step on problems with W's pattern.
+    std::vector<Eigen::Triplet<double>>& entries = buffers.entries;
+    entries.clear();
+    for (Eigen::Index c = 0; c < m; ++c) {
+      for (SparseMatrix::InnerIterator it(w, c); it; ++it) entries.emplace_back(it.row(), c, 0.0);
+      entries.emplace_back(c, c, 0.0);
+    }
     assemble_jacobian(blocks, lin, w, shift,
                       [&entries](Eigen::Index r, Eigen::Index c, double v) { entries.emplace_back(r, c, v); });
-    SparseMatrix j(m, m);
+    SparseMatrix& j = buffers.sparse_jacobian;
+    j.resize(m, m);
     j.setFromTriplets(entries.begin(), entries.end());
-    Eigen::SparseLU<SparseMatrix, Eigen::COLAMDOrdering<int>> lu;
-    lu.compute(j);
+    auto& lu = buffers.sparse_lu;
+    const bool same_pattern =
+        buffers.analysed_outer.size() == static_cast<std::size_t>(m) + 1 &&
+        std::equal(buffers.analysed_outer.begin(), buffers.analysed_outer.end(), w.outerIndexPtr()) &&
+        buffers.analysed_inner.size() == static_cast<std::size_t>(w.nonZeros()) &&
+        std::equal(buffers.analysed_inner.begin(), buffers.analysed_inner.end(), w.innerIndexPtr());
+    if (!same_pattern) {
+      lu.analyzePattern(j);
+      buffers.analysed_outer.assign(w.outerIndexPtr(), w.outerIndexPtr() + m + 1);
+      buffers.analysed_inner.assign(w.innerIndexPtr(), w.innerIndexPtr() + w.nonZeros());
+    }
+    lu.factorize(j);
+    if (lu.info() != Eigen::Success) {
+      buffers.analysed_outer.clear();  // analysed afresh next time
+      return false;
+    }
+    d = lu.solve(f);
     if (lu.info() != Eigen::Success) return false;
-    d = lu.solve(-f);
-    if (lu.info() != Eigen::Success) return false;
+    d = -d;
   }
   return d.allFinite();
 }
