@@ -281,7 +281,7 @@ bool newton_direction(const std::vector<Block>& blocks, const std::vector<Linear
     j.setFromTriplets(entries.begin(), entries.end());
     auto& lu = buffers.sparse_lu;
     const bool same_pattern =
-        buffers.analysed_outer.size() == static_cast<std::size_t>(m) + 1 &&
+        w.isCompressed() && buffers.analysed_outer.size() == static_cast<std::size_t>(m) + 1 &&
         std::equal(buffers.analysed_outer.begin(), buffers.analysed_outer.end(), w.outerIndexPtr()) &&
         buffers.analysed_inner.size() == static_cast<std::size_t>(w.nonZeros()) &&
         std::equal(buffers.analysed_inner.begin(), buffers.analysed_inner.end(), w.innerIndexPtr());
