@@ -1,6 +1,6 @@
 // LEDAS resolver with Coulomb friction, resolver level (hand-built bodies and contacts): Kane's rod and
-// the energy rule, Painlevé's rod, mirror symmetry, and the frictional solver's independence of the
-// tangent basis. Scenes over time are in tests/scenarios/test_scenario_friction.cpp.
+// the energy rule, Painlevé's rod, mirror symmetry, the frictional solver's independence of the tangent
+// basis, and its sparse path's kept analysis. Scenes over time are in tests/scenarios/test_scenario_friction.cpp.
 #include "ledas_test_support.hpp"
 
 #include "impetus/resolution/ledas/frictional_solver.hpp"
@@ -114,23 +114,32 @@ TEST(LedasFriction, MirrorSymmetricProblemGivesMirrorSymmetricImpulses) {
   EXPECT_NEAR(bodies[1].velocity.x(), 0.0, 1e-12);
 }
 
-// The frictional solver's answer does not depend on the tangent basis: the same contacts with each
-// tangent pair turned by a random angle give the same tangential impulses (turned back) and velocities,
-// to 1e-10 relative. W comes from a cluster of three spheres on the ground (15 rows, 18 degrees of
-// freedom), with random approach velocities and μ = 0.2, small enough for the solution to be unique (at
-// μ = 0.4 one seed in twenty has two Coulomb solutions, and the two bases may find different ones).
-TEST(LedasFriction, FrictionalSolverDoesNotDependOnTheTangentBasis) {
-  std::mt19937_64 random(17);
-  std::uniform_real_distribution<double> uniform(-1.0, 1.0);
+// A cluster of three spheres on the ground (masses 1, 2, 1.5 kg; 5 contacts, 15 rows, 18 degrees of
+// freedom) with random velocities from `random`, as a frictional problem with μ = 0.2 (small enough
+// for the solution to be unique: at μ = 0.4 one draw in twenty has two Coulomb solutions). Each
+// contact's tangent pair is turned about its normal by turn[k]; `rows` are the problem's rows.
+struct SphereCluster {
   std::vector<RigidBody> bodies{ground_plane(), sphere(0.5, 1.0, Vec3(0, 0, 0.5)), sphere(0.5, 2.0, Vec3(1, 0, 0.5)),
                                 sphere(0.5, 1.5, Vec3(0.5, 0, 0.5 + std::sqrt(0.75)))};
-  struct Pair {
-    BodyIndex a, b;
-  };
-  const Pair pairs[] = {{0, 1}, {0, 2}, {1, 3}, {2, 3}, {1, 2}};
-  const auto solve_with = [&](const std::vector<double>& turn, ledas::Vector& r, ledas::Vector& u) {
-    std::vector<resolution::ImpulseRow> rows;
-    for (std::size_t k = 0; k < std::size(pairs); ++k) {
+  static constexpr std::size_t kContacts = 5;
+
+  void draw_velocities(std::mt19937_64& random) {
+    std::uniform_real_distribution<double> uniform(-1.0, 1.0);
+    for (std::size_t i = 1; i < bodies.size(); ++i) {
+      bodies[i].velocity = Vec3(uniform(random), uniform(random), uniform(random) - 1.0);
+      bodies[i].angular_velocity = 3.0 * Vec3(uniform(random), uniform(random), uniform(random));
+    }
+  }
+
+  // W into `w`, and the problem on it (tolerance 1e-13).
+  ledas::FrictionalProblem problem(const std::vector<double>& turn, ledas::SparseMatrix& w,
+                                   std::vector<resolution::ImpulseRow>& rows) const {
+    struct Pair {
+      BodyIndex a, b;
+    };
+    const Pair pairs[kContacts] = {{0, 1}, {0, 2}, {1, 3}, {2, 3}, {1, 2}};
+    rows.clear();
+    for (std::size_t k = 0; k < kContacts; ++k) {
       const RigidBody &a = bodies[pairs[k].a], &b = bodies[pairs[k].b];
       const Vec3 n = pairs[k].a == 0 ? Vec3::UnitZ() : Vec3(b.position - a.position).normalized();
       const Vec3 point = pairs[k].a == 0 ? Vec3(b.position.x(), 0, 0) : Vec3(a.position + 0.5 * (b.position - a.position));
@@ -143,7 +152,7 @@ TEST(LedasFriction, FrictionalSolverDoesNotDependOnTheTangentBasis) {
     Eigen::MatrixXd dense(m, m);
     for (Eigen::Index i = 0; i < m; ++i)
       for (Eigen::Index k = 0; k < m; ++k) dense(i, k) = resolution::coupling(rows[static_cast<std::size_t>(i)], rows[static_cast<std::size_t>(k)]);
-    const ledas::SparseMatrix w = dense.sparseView();
+    w = dense.sparseView();
     ledas::FrictionalProblem problem;
     problem.w = &w;
     problem.q.resize(m);
@@ -153,15 +162,30 @@ TEST(LedasFriction, FrictionalSolverDoesNotDependOnTheTangentBasis) {
       problem.mu.insert(problem.mu.end(), {0.2, 0.0, 0.0});
     }
     problem.tolerance = 1e-13;
+    return problem;
+  }
+};
+
+// The frictional solver's answer does not depend on the tangent basis: the same contacts with each
+// tangent pair turned by a random angle give the same tangential impulses (turned back) and velocities,
+// to 1e-10 relative, on the sphere cluster above.
+TEST(LedasFriction, FrictionalSolverDoesNotDependOnTheTangentBasis) {
+  std::mt19937_64 random(17);
+  std::uniform_real_distribution<double> uniform(-1.0, 1.0);
+  SphereCluster cluster;
+  const auto solve_with = [&](const std::vector<double>& turn, ledas::Vector& r, ledas::Vector& u) {
+    ledas::SparseMatrix w;
+    std::vector<resolution::ImpulseRow> rows;
+    const ledas::FrictionalProblem problem = cluster.problem(turn, w, rows);
     ledas::FrictionalSolver solver;
     ledas::FrictionalStats stats;
     const ledas::Vector solution = solver.solve(problem, stats);
     EXPECT_EQ(stats.non_converged, 0u);
     // World vectors: each contact's impulse n p_n + s1 p_1 + s2 p_2 and velocity likewise.
-    r.resize(3 * static_cast<Eigen::Index>(std::size(pairs)));
+    r.resize(3 * static_cast<Eigen::Index>(SphereCluster::kContacts));
     u.resize(r.size());
     const ledas::Vector velocity = w * solution + problem.q;
-    for (std::size_t k = 0; k < std::size(pairs); ++k) {
+    for (std::size_t k = 0; k < SphereCluster::kContacts; ++k) {
       Vec3 p = Vec3::Zero(), v = Vec3::Zero();
       for (std::size_t j = 0; j < 3; ++j) {
         p += solution(static_cast<Eigen::Index>(3 * k + j)) * rows[3 * k + j].normal;
@@ -172,17 +196,49 @@ TEST(LedasFriction, FrictionalSolverDoesNotDependOnTheTangentBasis) {
     }
   };
   for (int trial = 0; trial < 20; ++trial) {
-    for (std::size_t i = 1; i < bodies.size(); ++i) {
-      bodies[i].velocity = Vec3(uniform(random), uniform(random), uniform(random) - 1.0);
-      bodies[i].angular_velocity = 3.0 * Vec3(uniform(random), uniform(random), uniform(random));
-    }
+    cluster.draw_velocities(random);
     ledas::Vector r0, u0, r1, u1;
-    solve_with(std::vector<double>(std::size(pairs), 0.0), r0, u0);
+    solve_with(std::vector<double>(SphereCluster::kContacts, 0.0), r0, u0);
     std::vector<double> turn;
-    for (std::size_t k = 0; k < std::size(pairs); ++k) turn.push_back(M_PI * uniform(random));
+    for (std::size_t k = 0; k < SphereCluster::kContacts; ++k) turn.push_back(M_PI * uniform(random));
     solve_with(turn, r1, u1);
     EXPECT_LE((r1 - r0).norm(), 1e-10 * std::max(1.0, r0.norm())) << "trial " << trial;
     EXPECT_LE((u1 - u0).norm(), 1e-10 * std::max(1.0, u0.norm())) << "trial " << trial;
+  }
+}
+
+// Newton's sparse path keeps its LU's ordering and symbolic analysis in the workspace while W's pattern
+// does not change. Problem after problem on one workspace (the sphere cluster with new velocities, and
+// every other draw new masses, so W's values change under the same pattern), solved on the sparse path
+// (dense_limit 4), each gives the velocities a fresh solver gives on the dense path to 1e-10 relative
+// (the solution is unique at μ = 0.2), and reaches its tolerance.
+TEST(LedasFriction, KeptSparseAnalysisSolvesProblemsWithNewValues) {
+  std::mt19937_64 random(29);
+  std::uniform_real_distribution<double> mass(0.5, 3.0);
+  SphereCluster cluster;
+  const std::vector<double> no_turn(SphereCluster::kContacts, 0.0);
+  ledas::FrictionalSettings sparse_settings;
+  sparse_settings.dense_limit = 4;
+  ledas::FrictionalSolver sparse(sparse_settings);
+  ledas::FrictionalWorkspace workspace;
+  for (int trial = 0; trial < 12; ++trial) {
+    cluster.draw_velocities(random);
+    if (trial % 2 == 1)
+      for (std::size_t i = 1; i < cluster.bodies.size(); ++i)
+        cluster.bodies[i] = sphere(0.5, mass(random), cluster.bodies[i].position, cluster.bodies[i].velocity);
+    ledas::SparseMatrix w;
+    std::vector<resolution::ImpulseRow> rows;
+    ledas::FrictionalProblem problem = cluster.problem(no_turn, w, rows);
+    ledas::FrictionalStats fresh_stats, kept_stats;
+    const ledas::Vector expected = ledas::FrictionalSolver().solve(problem, fresh_stats);
+    problem.workspace = &workspace;
+    ledas::Vector r;
+    sparse.solve(problem, kept_stats, r);
+    ASSERT_EQ(kept_stats.non_converged, 0u) << "trial " << trial;
+    ASSERT_EQ(fresh_stats.non_converged, 0u) << "trial " << trial;
+    EXPECT_LE(ledas::natural_map_residual(problem, r), problem.tolerance) << "trial " << trial;
+    const ledas::Vector u = w * r + problem.q, u_expected = w * expected + problem.q;
+    EXPECT_LE((u - u_expected).norm(), 1e-10 * std::max(1.0, u_expected.norm())) << "trial " << trial;
   }
 }
 
