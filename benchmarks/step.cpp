@@ -3,7 +3,8 @@
 // the initial state (the pyramid drop, the line push) is restored before each step, untimed, so the
 // rows measure one well-defined step rather than a scene that falls apart as the benchmark runs.
 //
-// Rows: step/<resolver>/<scene>; …_speculative_off with the detector's look-ahead off. Counters: bodies,
+// Rows: step/<resolver>/<scene>, on one thread (World::set_threads(1)); …_speculative_off with the
+// detector's look-ahead off; …_t2 on two threads (wall time). Counters: bodies, threads,
 // contacts, rounds, speculative_pairs, and the mean time per step of each stage (velocities_ms,
 // detect_ms, resolve_ms, positions_ms) plus resolve_share = resolve / total.
 // The resolvers run with their defaults (position correction on, warm starts on), as in a simulation.
@@ -86,7 +87,7 @@ std::vector<RigidBody> make_wall(int courses, int per_course, double mu) {
 enum class Scene { pyramid, line, resting_pyramid, stack, wall };
 
 void step(benchmark::State& state, const std::string& resolver_name, Scene scene, int n, double restitution,
-          bool speculative = true) {
+          bool speculative = true, std::uint32_t threads = 1) {
   const std::vector<RigidBody> initial =
       scene == Scene::pyramid ? make_pyramid(PyramidParams{.rows = n, .restitution = restitution})
       : scene == Scene::line  ? make_line(LineParams{.count = n, .restitution = restitution})
@@ -101,10 +102,12 @@ void step(benchmark::State& state, const std::string& resolver_name, Scene scene
   detector.speculative = speculative;
   world.set_detector(std::make_shared<FclDetector>(detector));
   world.set_resolver(bench::make_resolver(resolver_name, /*velocity_only=*/false));
+  world.set_threads(threads);
 
   const auto [sum, last, cold_ms, allocations] = bench::time_steps(state, world, initial, &bench::allocations);
   const auto per_step = benchmark::Counter::kAvgIterations;
   state.counters["bodies"] = static_cast<double>(initial.size() - 1);
+  state.counters["threads"] = static_cast<double>(world.threads());
   state.counters["contacts"] = static_cast<double>(last.detector.contacts);
   state.counters["rounds"] = static_cast<double>(last.resolver.rounds);
   state.counters["speculative_pairs"] = static_cast<double>(last.detector.speculative_pairs);
@@ -246,6 +249,16 @@ int register_all() {
             ->Unit(benchmark::kMillisecond);
       }
     }
+    // The single island of a large pyramid on two threads: ledas factorizes disjoint subtrees of its
+    // elimination tree in parallel (resolution/ledas/README.md). Wall time, since the work is shared.
+    if (resolver == "ledas")
+      for (int k : {50, 100}) {
+        if (k * (k + 1) / 2 > max_bodies) continue;
+        benchmark::RegisterBenchmark(("step/ledas/pyramid_" + std::to_string(k) + "_t2").c_str(),
+                                     [k](benchmark::State& st) { step(st, "ledas", Scene::pyramid, k, 0.0, true, 2); })
+            ->Unit(benchmark::kMillisecond)
+            ->UseRealTime();
+      }
     // Speculative contacts off: what the look-ahead costs where nothing is fast (compare with the rows
     // above; detection/fcl/README.md, "Fast bodies").
     if (resolver == "ledas") {

@@ -1,6 +1,8 @@
 #include "impetus/resolution/ledas/masked_ldlt.hpp"
 
 #include <Eigen/OrderingMethods>
+#include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
 
 #include <algorithm>
 #include <cassert>
@@ -32,6 +34,7 @@ void MaskedLdlt::analyze(const Matrix& a, std::span<const char> rows) {
   order_rows(a);
   upper_triangle();
   symbolic();
+  plan_subtrees(static_cast<SparseIndex>(std::min(tbb::this_task_arena::max_concurrency(), 16)));
   l_value_.resize(l_index_.size());
   d_.assign(n, 1.0);
   d_inverse_.assign(n, 0.0);
@@ -143,6 +146,96 @@ void MaskedLdlt::symbolic() {
   l_index_.resize(l_outer_.back());
 }
 
+// The parallel schedule for `parts` threads: the elimination tree split into disjoint subtrees, dealt
+// to `parts` groups, and the rows above them. Row k costs one multiply-add per entry already in each
+// column of its pattern (plus one): counted exactly on the full pattern. The heaviest subtree is split
+// (its root moved above the others) while that lowers the estimated time, the rows above plus the larger
+// of the heaviest subtree and an even share; the subtrees then go heaviest first to the least loaded
+// group. Small trees, and trees whose rows above would take most of the time (AMD's orderings often end
+// in a long chain of dense rows), stay serial. Which split is taken changes only the speed, never the
+// factor (see the file comment), so it may depend on the arena's size.
+void MaskedLdlt::plan_subtrees(SparseIndex parts) {
+  schedule_.clear();
+  group_outer_.clear();
+  const SparseIndex n = order_.size();
+  constexpr SparseIndex kParallelRows = 500;  // below, a factorization takes tens of µs: too little to share
+  if (parts < 2 || n < kParallelRows) return;
+  IndexVector<double> own(n, 0.0), subtree(n, 0.0);
+  IndexVector<SparseIndex> count(n, 0);
+  double total = 0.0;
+  for (SparseIndex k = 0; k < n; ++k) {
+    double work = 1.0;
+    for (SparseIndex t = row_outer_[k]; t < row_outer_[k + 1]; ++t) work += ++count[row_index_[t]];
+    own[k] = work;
+    total += work;
+    subtree[k] += work;  // its children, all before it, have added theirs
+    if (parent_[k] >= 0) subtree[parent_[k]] += subtree[k];
+  }
+  constexpr double kParallelWork = 100'000.0;  // multiply-adds: about 100 µs
+  if (total < kParallelWork) return;
+  IndexVector<SparseIndex> first_child(n, -1), next_sibling(n, -1);
+  for (SparseIndex k = n; k-- > 0;)
+    if (parent_[k] >= 0) {
+      next_sibling[k] = first_child[parent_[k]];
+      first_child[parent_[k]] = k;
+    }
+  // Candidates: a heap of (subtree weight, root), the heaviest (then the highest root) on top.
+  std::vector<std::pair<double, SparseIndex>> heap;
+  IndexVector<SparseIndex> label(n, -1);  // -2: above the subtrees; else its group once dealt
+  const auto split = [&](bool record) {  // the heaviest candidate's root goes above, its children in
+    std::pop_heap(heap.begin(), heap.end());
+    const SparseIndex root = heap.back().second;
+    heap.pop_back();
+    if (record) label[root] = -2;
+    for (SparseIndex c = first_child[root]; c >= 0; c = next_sibling[c]) {
+      heap.emplace_back(subtree[c], c);
+      std::push_heap(heap.begin(), heap.end());
+    }
+    return own[root];
+  };
+  const auto start = [&] {
+    heap.clear();
+    for (SparseIndex k = 0; k < n; ++k)
+      if (parent_[k] < 0) heap.emplace_back(subtree[k], k);
+    std::make_heap(heap.begin(), heap.end());
+  };
+  const double share = 1.0 / parts;
+  start();
+  double above = 0.0, best = total;
+  SparseIndex best_splits = 0;
+  for (SparseIndex splits = 1; !heap.empty() && above < best; ++splits) {
+    above += split(false);
+    if (heap.empty()) break;
+    const double estimate = above + std::max(heap.front().first, (total - above) * share);
+    if (estimate < best) {
+      best = estimate;
+      best_splits = splits;
+    }
+  }
+  if (best > 0.8 * total) return;  // less than 1.25× to gain
+  start();
+  for (SparseIndex s = 0; s < best_splits; ++s) split(true);
+  std::sort(heap.begin(), heap.end(), [](const auto& x, const auto& y) { return x.first > y.first || (x.first == y.first && x.second < y.second); });
+  std::vector<double> load(static_cast<std::size_t>(parts), 0.0);
+  for (const auto& [weight, root] : heap) {
+    const auto g = static_cast<SparseIndex>(std::min_element(load.begin(), load.end()) - load.begin());
+    load[static_cast<std::size_t>(g)] += weight;
+    label[root] = g;
+  }
+  for (SparseIndex k = n; k-- > 0;)
+    if (label[k] == -1) label[k] = label[parent_[k]];  // a subtree's rows join its root's group
+  // Rows by group, each group increasing, the rows above last (group `parts`).
+  group_outer_.assign(parts + 2, 0);
+  for (SparseIndex k = 0; k < n; ++k) ++group_outer_[(label[k] < 0 ? parts : label[k]) + 1];
+  std::partial_sum(group_outer_.begin(), group_outer_.end(), group_outer_.begin());
+  schedule_.resize(n);
+  IndexVector<SparseIndex> next(group_outer_.begin(), group_outer_.end() - 1);
+  for (SparseIndex k = 0; k < n; ++k) schedule_[next[label[k] < 0 ? parts : label[k]]++] = k;
+  group_work_.assign(parts, 0.0);
+  group_dropped_.assign(parts, 0);
+  split_count_.assign(n, 0);
+}
+
 bool MaskedLdlt::covers(std::span<const char> on) const {
   for (std::size_t k = 0; k < on.size(); ++k)
     if (on[k] && !analysed(k)) return false;
@@ -155,14 +248,45 @@ bool MaskedLdlt::same_pattern(const Matrix& a) const {
          std::equal(inner_.begin(), inner_.end(), a.innerIndexPtr());
 }
 
+std::size_t MaskedLdlt::factorize(const Matrix& a, std::span<const char> on, double rank_tolerance, double floor,
+                                  double shift) {
+  assert(covers(on) && "a row of F outside the analysed pattern would be factorized as if uncoupled");
+  double work = 0.0;
+  std::size_t dropped = 0;
+  if (schedule_.empty()) {
+    dropped = factorize_rows(nullptr, order_.size(), a, on, rank_tolerance, floor, shift, pattern_.data(), work);
+  } else {
+    // The groups of subtrees in parallel, each with its own slice of the scratch (a row of a group has
+    // fewer entries than the group has rows), then the rows above them. Sums in group order.
+    const SparseIndex parts = group_outer_.size() - 2;
+    tbb::parallel_for(SparseIndex{0}, parts, [&](SparseIndex g) {
+      const SparseIndex first = group_outer_[g];
+      group_work_[g] = 0.0;
+      group_dropped_[g] = factorize_rows(schedule_.data() + first, group_outer_[g + 1] - first, a, on,
+                                         rank_tolerance, floor, shift, pattern_.data() + first, group_work_[g]);
+    });
+    for (SparseIndex g = 0; g < parts; ++g) {
+      work += group_work_[g];
+      dropped += group_dropped_[g];
+    }
+    // Each column's entries from its own group (all of them before the rows above add theirs): the
+    // solves' parallel phase applies only those.
+    const SparseIndex first = group_outer_[parts];
+    for (SparseIndex r = 0; r < first; ++r) split_count_[schedule_[r]] = l_count_[schedule_[r]];
+    dropped += factorize_rows(schedule_.data() + first, group_outer_[parts + 1] - first, a, on, rank_tolerance, floor,
+                              shift, pattern_.data(), work);
+  }
+  work_ = work;
+  return dropped;
+}
+
 // ldl_numeric, row by row (row k of L from a sparse triangular solve along the elimination tree, on
 // the row pattern analyze() recorded), with rows off F skipped and rows with a vanishing pivot dropped.
 // Entries that come out exactly zero (a row of the full pattern that F does not reach) are not stored.
 // Kept in one piece: it is the hot loop of the complementary mode, and Davis's kernel reads best whole.
-std::size_t MaskedLdlt::factorize(const Matrix& a, std::span<const char> on, double rank_tolerance, double floor,
-                                  double shift) {
-  assert(covers(on) && "a row of F outside the analysed pattern would be factorized as if uncoupled");
-  const SparseIndex n = order_.size();
+std::size_t MaskedLdlt::factorize_rows(const SparseIndex* rows, SparseIndex count, const Matrix& a,
+                                       std::span<const char> on, double rank_tolerance, double floor, double shift,
+                                       SparseIndex* stored, double& work) {
   const double* value = a.valuePtr();
   const SparseIndex* c_outer = c_outer_.data();
   const SparseIndex* c_row = c_row_.data();
@@ -176,10 +300,10 @@ std::size_t MaskedLdlt::factorize(const Matrix& a, std::span<const char> on, dou
   double* y = y_.data();
   double* d_inverse = d_inverse_.data();
   char* state = state_.data();
-  SparseIndex* stored = pattern_.data();  // the columns row k put an entry in
   std::size_t dropped = 0;
-  double work = 0.0;
-  for (SparseIndex k = 0; k < n; ++k) {
+  double flops = 0.0;
+  for (SparseIndex r = 0; r < count; ++r) {
+    const SparseIndex k = rows != nullptr ? rows[r] : r;
     l_count[k] = 0;
     if (!on[order_[k]]) {
       state[k] = kOff;
@@ -205,14 +329,14 @@ std::size_t MaskedLdlt::factorize(const Matrix& a, std::span<const char> on, dou
       if (yi == 0.0 || state[i] != kOn) continue;
       const SparseIndex begin = l_outer[i];
       const SparseIndex end = begin + l_count[i];
-      work += end - begin + 1;
+      flops += end - begin + 1;
       for (SparseIndex p = begin; p < end; ++p) y[l_index[p]] -= l_value[p] * yi;
       const double lki = yi * d_inverse[i];
       dk -= lki * yi;
       l_index[end] = k;
       l_value[end] = lki;
       ++l_count[i];
-      stored[entries++] = i;
+      stored[entries++] = i;  // the columns row k put an entry in
     }
     diag_[k] = diagonal;
     if (diagonal <= floor || dk <= rank_tolerance * (diagonal + shift)) {
@@ -229,7 +353,7 @@ std::size_t MaskedLdlt::factorize(const Matrix& a, std::span<const char> on, dou
     d_[k] = dk;
     d_inverse[k] = 1.0 / dk;
   }
-  work_ = work;
+  work += flops;
   return dropped;
 }
 
@@ -251,6 +375,10 @@ void MaskedLdlt::solve(Eigen::Ref<Eigen::VectorXd> x) const {
 
 namespace impetus::ledas {
 
+// With a parallel schedule, forward() applies each column's entries within its own group in parallel
+// (a group's rows receive only from its own columns), then every column's entries in the rows above, in
+// column order; backward() does the rows above first, then the groups in parallel. Every entry of t and
+// x gets the same operations in the same order as in the serial sweeps, so the same bits.
 void MaskedLdlt::forward(const Eigen::Ref<const Eigen::VectorXd>& b, Eigen::VectorXd& t) const {
   const SparseIndex n = order_.size();
   t.resize(n);
@@ -260,12 +388,25 @@ void MaskedLdlt::forward(const Eigen::Ref<const Eigen::VectorXd>& b, Eigen::Vect
   const double* l_value = l_value_.data();
   double* y = t.data();
   for (SparseIndex k = 0; k < n; ++k) y[k] = state_[k] == kOn ? b(order_[k]) : 0.0;
-  for (SparseIndex j = 0; j < n; ++j) {  // L t = P b
+  // L t = P b: column j's entries [first, last) applied.
+  const auto apply = [&](SparseIndex j, SparseIndex first, SparseIndex last) {
     const double yj = y[j];
-    if (yj == 0.0) continue;
-    const SparseIndex end = l_outer[j] + l_count[j];
-    for (SparseIndex p = l_outer[j]; p < end; ++p) y[l_index[p]] -= l_value[p] * yj;
+    if (yj == 0.0) return;
+    for (SparseIndex p = first; p < last; ++p) y[l_index[p]] -= l_value[p] * yj;
+  };
+  if (schedule_.empty()) {
+    for (SparseIndex j = 0; j < n; ++j) apply(j, l_outer[j], l_outer[j] + l_count[j]);
+    return;
   }
+  const SparseIndex parts = group_outer_.size() - 2;
+  const SparseIndex* split = split_count_.data();
+  tbb::parallel_for(SparseIndex{0}, parts, [&](SparseIndex g) {
+    for (SparseIndex r = group_outer_[g]; r < group_outer_[g + 1]; ++r) {
+      const SparseIndex j = schedule_[r];
+      apply(j, l_outer[j], l_outer[j] + split[j]);
+    }
+  });
+  for (SparseIndex j = 0; j < n; ++j) apply(j, l_outer[j] + split[j], l_outer[j] + l_count[j]);
 }
 
 void MaskedLdlt::backward(Eigen::VectorXd& t, Eigen::Ref<Eigen::VectorXd> x) const {
@@ -276,11 +417,20 @@ void MaskedLdlt::backward(Eigen::VectorXd& t, Eigen::Ref<Eigen::VectorXd> x) con
   const double* l_value = l_value_.data();
   const double* d_inverse = d_inverse_.data();
   double* y = t.data();
-  for (SparseIndex j = n; j-- > 0;) {  // D⁻¹, then Lᵀ x = y
+  const auto row = [&](SparseIndex j) {  // D⁻¹, then Lᵀ x = y
     double yj = y[j] * d_inverse[j];
     const SparseIndex end = l_outer[j] + l_count[j];
     for (SparseIndex p = l_outer[j]; p < end; ++p) yj -= l_value[p] * y[l_index[p]];
     y[j] = yj;
+  };
+  if (schedule_.empty()) {
+    for (SparseIndex j = n; j-- > 0;) row(j);
+  } else {
+    const SparseIndex parts = group_outer_.size() - 2;
+    for (SparseIndex r = group_outer_[parts + 1]; r-- > group_outer_[parts];) row(schedule_[r]);
+    tbb::parallel_for(SparseIndex{0}, parts, [&](SparseIndex g) {
+      for (SparseIndex r = group_outer_[g + 1]; r-- > group_outer_[g];) row(schedule_[r]);
+    });
   }
   for (SparseIndex k = 0; k < n; ++k) x(order_[k]) = y[k];
 }

@@ -16,6 +16,11 @@
 ///
 /// Up-looking sparse LDLᵀ (T. Davis, "Algorithm 849: a concise sparse Cholesky factorization package").
 /// No allocation after analyze(); deterministic.
+///
+/// Threads: row k of L depends only on the rows of its elimination subtree, so disjoint subtrees are
+/// factorized in parallel (oneTBB, in the caller's task arena), and the rows above them after them.
+/// Each row is computed by the same operations in the same order whichever thread runs it and however
+/// the tree is split, so the factor's bits do not depend on the thread count.
 
 #include <Eigen/SparseCore>
 
@@ -117,6 +122,9 @@ class MaskedLdlt {
   std::size_t rows() const { return static_cast<std::size_t>(order_.size()); }
   /// Entries of L the full pattern allows (work per solve ~ 2× this).
   std::size_t capacity() const { return static_cast<std::size_t>(l_index_.size()); }
+  /// Groups of subtrees factorize() runs in parallel (0: one serial pass), planned by analyze() for the
+  /// calling task arena's threads.
+  std::size_t parallel_groups() const { return schedule_.empty() ? 0 : static_cast<std::size_t>(group_outer_.size() - 2); }
 
  private:
   static constexpr char kOff = 0, kOn = 1, kDropped = 2;
@@ -126,6 +134,12 @@ class MaskedLdlt {
   void order_rows(const Matrix& a);
   void upper_triangle();
   void symbolic();
+  // The split of the elimination tree into subtrees factorized in parallel (see the file comment).
+  void plan_subtrees(SparseIndex parts);
+  // factorize() on the rows rows[0..count) in that order, with `stored` as the scratch of their entries;
+  // adds the work, returns the rows dropped.
+  std::size_t factorize_rows(const SparseIndex* rows, SparseIndex count, const Matrix& a, std::span<const char> on,
+                             double rank_tolerance, double floor, double shift, SparseIndex* stored, double& work);
 
   IndexVector<SparseIndex> outer_, inner_;       // the pattern of A
   IndexVector<char> analysed_;                   // per row: in the analysed pattern (may be in F)
@@ -137,6 +151,13 @@ class MaskedLdlt {
   IndexVector<SparseIndex> row_outer_, row_index_;  // pattern of each row of L for the full pattern (topological)
   IndexVector<double> l_value_, d_, d_inverse_, diag_;  // d_inverse_: 1/d on rows of F kept, else 0
   IndexVector<char> state_;
+  // The parallel schedule (plan_subtrees): group g's rows are schedule_[group_outer_[g] .. group_outer_[g+1]),
+  // increasing, each group a union of disjoint subtrees; the last group holds the rows above them and runs
+  // after the others. Empty: one serial pass over every row.
+  IndexVector<SparseIndex> schedule_, group_outer_;
+  IndexVector<double> group_work_;            // per group of the last factorize()
+  IndexVector<std::size_t> group_dropped_;
+  IndexVector<SparseIndex> split_count_;      // per column: its entries in its own group's rows (0 above)
   // Workspace.
   mutable IndexVector<double> y_;
   IndexVector<SparseIndex> flag_, pattern_;
