@@ -16,6 +16,9 @@
 /// - knocked_wall_N: a wall of N bricks (0.4 × 0.2 × 0.2 m, 25 per course, running bond, as
 ///   benchmarks/step.cpp's walls) on the ground, hit at a quarter of its height by a 200 kg ball
 ///   (r = 0.4 m) at 8 m/s; the snapshot at 0.02 s has the impact spreading through the wall.
+/// - pyramid_K: the paper's pyramid of K rows (K(K+1)/2 unit spheres of r = 0.5 m, core's generator)
+///   placed at rest on the ground; the snapshot at 0.02 s. One island whose contacts all persist, the
+///   large single system of the set (K = 100: 5,050 spheres, 14,950 contacts).
 ///
 /// With friction μ (…_mu0.5) every body, ground and wall included, gets μ.
 
@@ -24,6 +27,7 @@
 #include "impetus/core/body.hpp"
 #include "impetus/core/mass.hpp"
 #include "impetus/detection/fcl/fcl_detector.hpp"
+#include "impetus/engine/generators.hpp"
 #include "impetus/engine/world.hpp"
 #include "impetus/integrators/momentum/momentum.hpp"
 
@@ -160,6 +164,7 @@ inline DynamicScene dynamic_scene(const std::string& family, int n, double mu) {
   if (family == "pile") return {make_pile(n, mu), 400};
   if (family == "heap") return {make_heap(n, mu), 300};
   if (family == "knocked_wall") return {make_knocked_wall(n, mu), 20};
+  if (family == "pyramid") return {make_pyramid(PyramidParams{.rows = n, .velocity = Vec3::Zero(), .friction = mu}), 20};
   throw std::invalid_argument("no dynamic scene family '" + family + "'");
 }
 

@@ -48,7 +48,11 @@ void LedasResolver::velocity_complementary(ledas::Island& island, std::span<Rigi
     if (round > 0 &&
         (lane.stats.velocity.infeasible > failed_before || lane.stats.velocity.non_converged > unconverged_before))
       break;  // counted by the solver already
-    if (settings_.start_set == LedasStartSet::impact) narrow_start_set(lane, island, v, problem.start);
+    if (settings_.start_set == LedasStartSet::impact) {
+      add_closable_gaps(island, v, problem.start);
+
+      narrow_start_set(lane, island, v, problem.start);
+    }
     problem.rhs = target - v;
     const std::uint64_t before = lane.stats.velocity.iterations;
     Vector& p = island.impact_solution;
@@ -61,7 +65,29 @@ void LedasResolver::velocity_complementary(ledas::Island& island, std::span<Rigi
   }
 }
 
-// The complementary mode's start set (README.md, "The start set"): of the touching contacts, only those
+// The complementary mode's start set, first half (README.md, "The start set"): a separating contact the
+// impact can close joins the touching ones: one whose slack v_n − target is at most the largest approach
+// deficit target − v_n of the island's contacts, the speed the impact takes out of the approaching
+// bodies and can pass on. Under gravity every body gains the same −g dt, so only the contacts with the
+// ground approach; a pile whose layers drift apart slowly (a frictionless pyramid spreading) would
+// otherwise join one layer per active-set iteration as each lands on the one below, where now the first
+// solve takes them all.
+void LedasResolver::add_closable_gaps(const ledas::Island& island, const Vector& v, std::vector<char>& start) const {
+  const std::size_t m = island.rows.size();
+  double reach = 0.0;
+  for (std::size_t i = 0; i < m; ++i) {
+    const auto ei = static_cast<Eigen::Index>(i);
+    if (!island.equality[i]) reach = std::max(reach, island.target(ei) - v(ei));
+  }
+  if (reach <= settings_.tolerance) return;
+  for (std::size_t i = 0; i < m; ++i) {
+    const auto ei = static_cast<Eigen::Index>(i);
+    if (!start[i] && !island.equality[i] && v(ei) - island.target(ei) <= reach)
+      start[i] = 1;
+  }
+}
+
+// The start set, second half: of the touching contacts, only those
 // that can pass the impact on. The impact's sources are the movable bodies of the approaching contacts
 // and of the joint rows off their target; every movable body's distance from them is counted in hops
 // over the rows of the start set (breadth-first). A touching contact between two movable bodies at the

@@ -290,6 +290,34 @@ TEST(LedasSystems, ImpactStartSetKeepsThePyramidsAnswer) {
   }
 }
 
+// Closable gaps in the start set (complementary_impact.cpp): a column of 30 unit spheres (1 kg) on the
+// ground, sphere i falling at 9.81 − 0.1 i mm/s, so the ground's contact approaches and every other
+// separates at 0.1 mm/s, less than the ground takes out of the bottom sphere. With e = 0 everything
+// stops (each sphere reaches the one below once that one has stopped), and the contact under sphere i
+// carries the momentum of sphere i and those above: Σ_{j≥i} (9.81 − 0.1 j) mm/s · 1 kg (analytic,
+// 1e-12). Started with the touching contacts alone, the search adds one sphere per iteration (30
+// iterations); with the impact's start set the first solve has them all (one iteration). Same answer.
+TEST(LedasSystems, ImpactStartSetTakesTheGapsTheImpactCloses) {
+  constexpr int kCount = 30;
+  const auto fall = [](int i) { return 9.81e-3 - 1e-4 * i; };
+  std::vector<RigidBody> column;
+  for (int i = 0; i < kCount; ++i) column.push_back(sphere(0.5, 1.0, {0, 0, 0.5 + i * (1.0 - 1e-7)}, {0, 0, -fall(i)}));
+  column.push_back(ground_plane());
+  const Outcome a = run(column, settings_for(LedasMode::complementary)), b = run(column, touching_start());
+  expect_same_exact_answer(a, b);
+  for (const Outcome* o : {&a, &b}) {
+    for (int i = 0; i < kCount; ++i) EXPECT_LT(o->bodies[static_cast<std::size_t>(i)].velocity.norm(), 1e-12) << i;
+    for (const Contact& c : o->contacts) {
+      const int lower = c.b == kCount ? 0 : static_cast<int>(c.b);  // the sphere above the contact
+      double carried = 0.0;
+      for (int j = lower; j < kCount; ++j) carried += fall(j);
+      EXPECT_NEAR(c.impulse, carried, 1e-12) << "contact under sphere " << lower;
+    }
+  }
+  EXPECT_EQ(a.stats.velocity.iterations, 1u);
+  EXPECT_EQ(b.stats.velocity.iterations, static_cast<std::uint64_t>(kCount));
+}
+
 // A contact across the front that must push: P → L | R ← Q, four touching unit spheres in a line, the
 // ends moving inward at 1 m/s, e = 0. L and R are both struck (the same distance from the impact), so
 // L–R starts out of the impact's start set; the first solve leaves them approaching at 2 m/s and the

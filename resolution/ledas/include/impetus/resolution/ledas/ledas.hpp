@@ -142,6 +142,7 @@ class LedasResolver final : public CollisionResolver {
   void remember_impulses(Lane& lane, const ledas::Island& island, std::span<const Contact> contacts) const;
   void apply_island_impulse(ledas::Island& island, const ledas::Vector& p, std::span<RigidBody> bodies,
                             Lane& lane);
+  void add_closable_gaps(const ledas::Island& island, const ledas::Vector& v, std::vector<char>& start) const;
   void narrow_start_set(Lane& lane, const ledas::Island& island, const ledas::Vector& v, std::vector<char>& start);
   void finish_round(ledas::Island& island, const ledas::Vector& p, const ledas::Vector& target,
                     std::span<RigidBody> bodies);
