@@ -39,8 +39,8 @@ run_as dynamic step --benchmark_filter='_t[0-9]+$'
 run detect
 run model
 if [ -x "$build/bin/bench_peers" ]; then
-  run peers --benchmark_filter='-(/heap_|/pile_|/knocked_wall_|_mu)'
-  run_as dynamic_peers peers --benchmark_filter='/(heap|pile|knocked_wall)_'
+  run peers --benchmark_filter='-(/heap_|/pile_|/knocked_wall_|_gravity/pyramid_100|_mu)'
+  run_as dynamic_peers peers --benchmark_filter='/(heap|pile|knocked_wall)_|_gravity/pyramid_100'
   run_as friction_peers peers --benchmark_filter='_mu'
   mkdir -p "$root/docs/charts"
   "$py" "$root/benchmarks/peers/report.py" "$data/peers.json" --chart "$root/docs/charts/peers.png" \

@@ -296,7 +296,7 @@ def cold_table(rows):
 
 def dynamic_peers_table(rows):
     """bench_peers' rows on the dynamic scenes: one whole step under gravity from a snapshot per engine."""
-    families = ("heap_", "pile_", "knocked_wall_")
+    families = ("heap_", "pile_", "knocked_wall_", "pyramid_")
     entries = []
     for name, row in rows.items():
         parts = name.split("/")
