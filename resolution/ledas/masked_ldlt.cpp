@@ -160,48 +160,53 @@ void MaskedLdlt::plan_subtrees(SparseIndex parts) {
   const SparseIndex n = order_.size();
   constexpr SparseIndex kParallelRows = 500;  // below, a factorization takes tens of µs: too little to share
   if (parts < 2 || n < kParallelRows) return;
-  IndexVector<double> own(n, 0.0), subtree(n, 0.0);
-  IndexVector<SparseIndex> count(n, 0);
+  // The scratch is the plan's own, kept between analyses (assign() reuses its storage).
+  PlanScratch& t = plan_;
+  t.own.assign(n, 0.0);
+  t.subtree.assign(n, 0.0);
+  t.count.assign(n, 0);
   double total = 0.0;
   for (SparseIndex k = 0; k < n; ++k) {
     double work = 1.0;
-    for (SparseIndex t = row_outer_[k]; t < row_outer_[k + 1]; ++t) work += ++count[row_index_[t]];
-    own[k] = work;
+    for (SparseIndex q = row_outer_[k]; q < row_outer_[k + 1]; ++q) work += ++t.count[row_index_[q]];
+    t.own[k] = work;
     total += work;
-    subtree[k] += work;  // its children, all before it, have added theirs
-    if (parent_[k] >= 0) subtree[parent_[k]] += subtree[k];
+    t.subtree[k] += work;  // its children, all before it, have added theirs
+    if (parent_[k] >= 0) t.subtree[parent_[k]] += t.subtree[k];
   }
   constexpr double kParallelWork = 100'000.0;  // multiply-adds: about 100 µs
   if (total < kParallelWork) return;
-  IndexVector<SparseIndex> first_child(n, -1), next_sibling(n, -1);
+  t.first_child.assign(n, -1);
+  t.next_sibling.assign(n, -1);
   for (SparseIndex k = n; k-- > 0;)
     if (parent_[k] >= 0) {
-      next_sibling[k] = first_child[parent_[k]];
-      first_child[parent_[k]] = k;
+      t.next_sibling[k] = t.first_child[parent_[k]];
+      t.first_child[parent_[k]] = k;
     }
   // Candidates: a heap of (subtree weight, root), the heaviest (then the highest root) on top.
-  std::vector<std::pair<double, SparseIndex>> heap;
-  IndexVector<SparseIndex> label(n, -1);  // -2: above the subtrees; else its group once dealt
+  std::vector<std::pair<double, SparseIndex>>& heap = t.heap;
+  t.label.assign(n, -1);  // -2: above the subtrees; else its group once dealt
   const auto split = [&](bool record) {  // the heaviest candidate's root goes above, its children in
     std::pop_heap(heap.begin(), heap.end());
     const SparseIndex root = heap.back().second;
     heap.pop_back();
-    if (record) label[root] = -2;
-    for (SparseIndex c = first_child[root]; c >= 0; c = next_sibling[c]) {
-      heap.emplace_back(subtree[c], c);
+    if (record) t.label[root] = -2;
+    for (SparseIndex c = t.first_child[root]; c >= 0; c = t.next_sibling[c]) {
+      heap.emplace_back(t.subtree[c], c);
       std::push_heap(heap.begin(), heap.end());
     }
-    return own[root];
+    return t.own[root];
   };
   const auto start = [&] {
     heap.clear();
     for (SparseIndex k = 0; k < n; ++k)
-      if (parent_[k] < 0) heap.emplace_back(subtree[k], k);
+      if (parent_[k] < 0) heap.emplace_back(t.subtree[k], k);
     std::make_heap(heap.begin(), heap.end());
   };
   const double share = 1.0 / parts;
   start();
-  double above = 0.0, best = total;
+  // The estimate with no split (a forest may be balanced as it is), then after each split.
+  double above = 0.0, best = std::max(heap.front().first, total * share);
   SparseIndex best_splits = 0;
   for (SparseIndex splits = 1; !heap.empty() && above < best; ++splits) {
     above += split(false);
@@ -216,21 +221,22 @@ void MaskedLdlt::plan_subtrees(SparseIndex parts) {
   start();
   for (SparseIndex s = 0; s < best_splits; ++s) split(true);
   std::sort(heap.begin(), heap.end(), [](const auto& x, const auto& y) { return x.first > y.first || (x.first == y.first && x.second < y.second); });
-  std::vector<double> load(static_cast<std::size_t>(parts), 0.0);
+  t.load.assign(static_cast<std::size_t>(parts), 0.0);
   for (const auto& [weight, root] : heap) {
-    const auto g = static_cast<SparseIndex>(std::min_element(load.begin(), load.end()) - load.begin());
-    load[static_cast<std::size_t>(g)] += weight;
-    label[root] = g;
+    const auto g = static_cast<SparseIndex>(std::min_element(t.load.begin(), t.load.end()) - t.load.begin());
+    t.load[static_cast<std::size_t>(g)] += weight;
+    t.label[root] = g;
   }
   for (SparseIndex k = n; k-- > 0;)
-    if (label[k] == -1) label[k] = label[parent_[k]];  // a subtree's rows join its root's group
+    if (t.label[k] == -1) t.label[k] = t.label[parent_[k]];  // a subtree's rows join its root's group
   // Rows by group, each group increasing, the rows above last (group `parts`).
+  const auto group_of = [&](SparseIndex k) { return t.label[k] < 0 ? parts : t.label[k]; };
   group_outer_.assign(parts + 2, 0);
-  for (SparseIndex k = 0; k < n; ++k) ++group_outer_[(label[k] < 0 ? parts : label[k]) + 1];
+  for (SparseIndex k = 0; k < n; ++k) ++group_outer_[group_of(k) + 1];
   std::partial_sum(group_outer_.begin(), group_outer_.end(), group_outer_.begin());
   schedule_.resize(n);
-  IndexVector<SparseIndex> next(group_outer_.begin(), group_outer_.end() - 1);
-  for (SparseIndex k = 0; k < n; ++k) schedule_[next[label[k] < 0 ? parts : label[k]]++] = k;
+  t.count.assign(group_outer_.begin(), group_outer_.end() - 1);  // each group's next slot
+  for (SparseIndex k = 0; k < n; ++k) schedule_[t.count[group_of(k)]++] = k;
   group_work_.assign(parts, 0.0);
   group_dropped_.assign(parts, 0);
   split_count_.assign(n, 0);

@@ -179,7 +179,9 @@ TEST(MaskedLdlt, ParallelSubtreesGiveTheSerialBits) {
     if (shift == 0.0) {
       const Vector r = a * zp - c;
       for (int i = 0; i < n; ++i) {
-        if (on[static_cast<std::size_t>(i)]) EXPECT_LT(std::abs(r(i)), 1e-9 * c.norm()) << "row " << i;
+        if (on[static_cast<std::size_t>(i)]) {
+          EXPECT_LT(std::abs(r(i)), 1e-9 * c.norm()) << "row " << i;
+        }
       }
     }
   }

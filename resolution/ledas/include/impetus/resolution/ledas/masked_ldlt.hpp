@@ -158,6 +158,12 @@ class MaskedLdlt {
   IndexVector<double> group_work_;            // per group of the last factorize()
   IndexVector<std::size_t> group_dropped_;
   IndexVector<SparseIndex> split_count_;      // per column: its entries in its own group's rows (0 above)
+  struct PlanScratch {  // plan_subtrees()'s, kept so that a new analysis of a large island reuses it
+    IndexVector<double> own, subtree;             // a row's multiply-adds; its subtree's
+    IndexVector<SparseIndex> count, first_child, next_sibling, label;
+    std::vector<std::pair<double, SparseIndex>> heap;
+    std::vector<double> load;
+  } plan_;
   // Workspace.
   mutable IndexVector<double> y_;
   IndexVector<SparseIndex> flag_, pattern_;
