@@ -175,8 +175,6 @@ void resolve_cold(benchmark::State& state, const std::string& resolver_name, con
   state.counters["warm_factorizations"] = per_run(warm_sparse);
 }
 
-/// Rows left out: the paper mode on pyramid K = 100 (tens of thousands of rounds on 15 000 contacts) and
-/// on the line N = 10 000 with e = 0 (its round cap times 10⁴ rows: minutes per iteration).
 /// A row's function run in a task arena of one thread.
 template <class Row>
 auto one_thread(Row row) {
@@ -186,6 +184,8 @@ auto one_thread(Row row) {
   };
 }
 
+/// Rows left out: the paper mode on pyramid K = 100 (tens of thousands of rounds on 15 000 contacts) and
+/// on the line N = 10 000 with e = 0 (its round cap times 10⁴ rows: minutes per iteration).
 bool too_slow(const std::string& resolver, const std::string& scene) {
   return resolver == "ledas_paper" && (scene == "pyramid_100" || scene == "line_10000_e0");
 }

@@ -50,7 +50,6 @@ void LedasResolver::velocity_complementary(ledas::Island& island, std::span<Rigi
       break;  // counted by the solver already
     if (settings_.start_set == LedasStartSet::impact) {
       add_closable_gaps(island, v, problem.start);
-
       narrow_start_set(lane, island, v, problem.start);
     }
     problem.rhs = target - v;
