@@ -4,6 +4,7 @@
 #include "impetus/resolution/ledas/frictional_solver.hpp"
 
 #include "cone_qp.hpp"
+#include "impetus/resolution/ledas/masked_ldlt.hpp"
 
 #include <Eigen/Eigenvalues>
 #include <Eigen/LU>
@@ -69,6 +70,11 @@ struct FrictionalWorkspace::Newton {
   SparseMatrix sparse_jacobian;
   Eigen::SparseLU<SparseMatrix, Eigen::COLAMDOrdering<int>> sparse_lu;
   std::vector<SparseMatrix::StorageIndex> analysed_outer, analysed_inner;
+  // The symmetric path's (no block slides): LDLᵀ of (W + shift I) on the active rows, W's analysis kept
+  // while its pattern does not change; the active rows and the right-hand side.
+  MaskedLdlt ldlt;
+  std::vector<char> active;
+  Vector rhs;
 };
 
 FrictionalWorkspace::FrictionalWorkspace() = default;
@@ -250,8 +256,57 @@ void assemble_jacobian(const std::vector<Block>& blocks, const std::vector<Linea
   }
 }
 
+// Whether the Jacobian is symmetric up to its rows' weights: every block open (J = I) or active
+// (J = diag(ρ)(W + shift I)), none sliding or on the relaxation's cone surface.
+bool symmetric_pieces(const std::vector<Linearization>& lin) {
+  return std::all_of(lin.begin(), lin.end(),
+                     [](const Linearization& l) { return l.piece == Piece::open || l.piece == Piece::active; });
+}
+
+// The Newton direction when symmetric_pieces(lin): on the open rows O, d_O = −F_O; on the active rows A,
+// (W + shift I)_AA d_A = −F_A/ρ − W_AO d_O, symmetric positive definite (shift > 0), by sparse LDLᵀ on
+XX
+// threads (MaskedLdlt). With shift = 0 a redundant row of A is dropped (the basic solution, which gives
+// the same W d).
+bool symmetric_direction(const std::vector<Block>& blocks, const std::vector<Linearization>& lin, const SparseMatrix& w,
+                         double shift, const Vector& f, FrictionalWorkspace::Newton& buffers, Vector& d) {
+  constexpr double kRankTolerance = 1e-12;  // only used without a shift
+  const Eigen::Index m = f.size();
+  std::vector<char>& active = buffers.active;
+  active.assign(static_cast<std::size_t>(m), 0);
+  Vector& rhs = buffers.rhs;
+  rhs.setZero(m);
+  d.resize(m);
+  for (std::size_t k = 0; k < blocks.size(); ++k) {
+    const Block& b = blocks[k];
+    for (int j = 0; j < b.size; ++j) {
+      const Eigen::Index row = b.first + j;
+      if (lin[k].piece == Piece::open) {
+        d(row) = -f(row);
+        continue;
+      }
+      active[static_cast<std::size_t>(row)] = 1;
+      d(row) = 0.0;
+      rhs(row) = -f(row) / (j == 0 ? b.rho_n : b.rho_t);
+    }
+  }
+  for (Eigen::Index c = 0; c < m; ++c) {  // − W_AO d_O
+    if (active[static_cast<std::size_t>(c)] || d(c) == 0.0) continue;
+    for (SparseMatrix::InnerIterator it(w, c); it; ++it)
+      if (active[static_cast<std::size_t>(it.row())]) rhs(it.row()) -= it.value() * d(c);
+  }
+  MaskedLdlt& ldlt = buffers.ldlt;
+  if (!ldlt.same_pattern(w)) ldlt.analyze(w);
+  ldlt.factorize(w, active, shift > 0.0 ? 0.0 : kRankTolerance, 0.0, shift);
+  ldlt.solve(rhs);
+  for (Eigen::Index row = 0; row < m; ++row)
+    if (active[static_cast<std::size_t>(row)]) d(row) = rhs(row);
+  return d.allFinite();
+}
+
 // The Newton direction: J d = −F, into d (the dense path in `buffers`, without allocating when the
-// size did not change). False if the system could not be solved to finite values.
+// size did not change; the symmetric path when no block slides). False if the system could not be
+// solved to finite values.
 bool newton_direction(const std::vector<Block>& blocks, const std::vector<Linearization>& lin, const SparseMatrix& w,
                       double shift, const Vector& f, std::size_t dense_limit, FrictionalWorkspace::Newton& buffers,
                       Vector& d) {
@@ -265,6 +320,8 @@ bool newton_direction(const std::vector<Block>& blocks, const std::vector<Linear
     // side), without a temporary for −F.
     d.noalias() = buffers.lu.solve(f);
     d = -d;
+  } else if (w.isCompressed() && symmetric_pieces(lin)) {
+    return symmetric_direction(blocks, lin, w, shift, f, buffers, d);
   } else {
     // The Jacobian on the fixed pattern of W + I (explicit zeros where this linearization has none), so
     // that one ordering and symbolic analysis serve every Newton step on problems with W's pattern.

@@ -242,6 +242,63 @@ TEST(LedasFriction, KeptSparseAnalysisSolvesProblemsWithNewValues) {
   }
 }
 
+// A column of 40 spheres (radius 0.5, masses 1 + 0.1 k) stacked on the ground at μ = 0.7: the lower 39
+// move down at 1 m/s, the top one up at 1 m/s. Every contact below the top sphere is pressed and sticks
+// (no tangential motion at all), and the impact stops the 39: contact c (below sphere c) carries the
+// momentum of spheres c … 38, r_n = Σ m_j × 1 m/s, r_t = 0; the top contact opens (r = 0). From a warm
+// start that is wrong on every contact (the pressed impulses × 0.9, 0.3 N·s on the open contact, a
+// tangential push), Newton solves it in one step up to the Jacobian's shift (1e-10 max W_ii), and to the
+// tolerance 1e-12 in two: every block is active or open there, so the Alart–Curnier function is linear,
+// and Newton's system is the symmetric one on the active rows (120 rows: the sparse path), which must
+// also carry the open contact's correction across. Impulses to 1e-10 relative, velocities to 1e-10 m/s.
+TEST(LedasFriction, NewtonSolvesAStickingColumnFromAWrongWarmStartInTwoSteps) {
+  constexpr int kSpheres = 40;
+  std::vector<RigidBody> bodies{ground_plane()};
+  for (int k = 0; k < kSpheres; ++k)
+    bodies.push_back(sphere(0.5, 1.0 + 0.1 * k, Vec3(0, 0, 0.5 + k), Vec3(0, 0, k + 1 < kSpheres ? -1.0 : 1.0)));
+  std::vector<resolution::ImpulseRow> rows;
+  for (int c = 0; c < kSpheres; ++c) {
+    const Vec3 n = Vec3::UnitZ();
+    Vec3 t1, t2;
+    tangent_basis(n, t1, t2);
+    for (const Vec3& d : {n, t1, t2})
+      rows.push_back(resolution::make_row(bodies, static_cast<BodyIndex>(c), static_cast<BodyIndex>(c + 1),
+                                          Vec3(0, 0, c), d));
+  }
+  const auto m = static_cast<Eigen::Index>(rows.size());
+  Eigen::MatrixXd dense(m, m);
+  for (Eigen::Index i = 0; i < m; ++i)
+    for (Eigen::Index k = 0; k < m; ++k)
+      dense(i, k) = resolution::coupling(rows[static_cast<std::size_t>(i)], rows[static_cast<std::size_t>(k)]);
+  const ledas::SparseMatrix w = dense.sparseView();
+  ledas::FrictionalProblem problem;
+  problem.w = &w;
+  problem.q.resize(m);
+  for (Eigen::Index i = 0; i < m; ++i) problem.q(i) = resolution::row_velocity(rows[static_cast<std::size_t>(i)], bodies);
+  for (int c = 0; c < kSpheres; ++c) {
+    problem.role.insert(problem.role.end(), {ledas::RowRole::normal, ledas::RowRole::tangent, ledas::RowRole::tangent});
+    problem.mu.insert(problem.mu.end(), {0.7, 0.0, 0.0});
+  }
+  problem.tolerance = 1e-12;
+  ledas::Vector expected = ledas::Vector::Zero(m);
+  for (int c = kSpheres - 2; c >= 0; --c) expected(3 * c) = (c + 1 < kSpheres - 1 ? expected(3 * (c + 1)) : 0.0) + 1.0 + 0.1 * c;
+  ledas::Vector start = 0.9 * expected;
+  start(3 * (kSpheres - 1)) = 0.3;
+  start(3 * 5 + 1) = 0.05;  // a tangential impulse inside the cone, which the answer must remove
+  problem.start = &start;
+  ASSERT_GT(m, static_cast<Eigen::Index>(ledas::FrictionalSettings{}.dense_limit));
+
+  ledas::FrictionalStats stats;
+  const ledas::Vector r = ledas::FrictionalSolver().solve(problem, stats);
+  EXPECT_EQ(stats.warm_started, 1u);
+  EXPECT_EQ(stats.newton_steps, 2u);  // the second removes what the Jacobian's shift left (~1e-9)
+  EXPECT_LE((r - expected).norm(), 1e-10 * expected.norm());
+  const ledas::Vector u = w * r + problem.q;
+  for (int c = 0; c + 1 < kSpheres; ++c)
+    EXPECT_LE(u.segment<3>(3 * c).norm(), 1e-10) << "contact " << c << " slips or separates";
+  EXPECT_NEAR(u(3 * (kSpheres - 1)), 1.0, 1e-10) << "the top sphere leaves at 1 m/s";
+}
+
 }  // namespace
 }  // namespace impetus
 

@@ -24,7 +24,8 @@
 /// whose zeros are exactly the solutions above (ρ > 0 per contact; the cone is round and ρ_t is one
 /// number per contact, so the iteration does not depend on the tangent basis). Each step solves the
 /// generalized Jacobian's system by LU (dense up to `dense_limit` rows, sparse above, W shifted by
-/// `regularization` × max W_ii so redundant contact sets stay solvable), with an Armijo line search on
+/// `regularization` × max W_ii so redundant contact sets stay solvable; above `dense_limit`, when no block
+/// slides, by symmetric LDLᵀ on the active rows instead), with an Armijo line search on
 /// ½‖F‖². The error is fclib's natural-map residual ‖r − P_K(r − (u + μ‖u_t‖ e_n))‖ (ρ = 1, no scaling).
 /// Redundant contacts (more rows than `dofs`: W singular, the impulses not unique) or a stalled Newton:
 /// proximal points take over — the same Newton on u = (W + εI) r + q − ε r̄, r̄ moved to each solution, ε
