@@ -265,7 +265,7 @@ bool symmetric_pieces(const std::vector<Linearization>& lin) {
 
 // The Newton direction when symmetric_pieces(lin): on the open rows O, d_O = −F_O; on the active rows A,
 // (W + shift I)_AA d_A = −F_A/ρ − W_AO d_O, symmetric positive definite (shift > 0), by sparse LDLᵀ on
-XX
+// W's pattern restricted to A: less work than J's LU (symmetric, no pivoting), and it splits across
 // threads (MaskedLdlt). With shift = 0 a redundant row of A is dropped (the basic solution, which gives
 // the same W d).
 bool symmetric_direction(const std::vector<Block>& blocks, const std::vector<Linearization>& lin, const SparseMatrix& w,
