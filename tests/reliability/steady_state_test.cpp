@@ -101,13 +101,17 @@ std::string test_name(const testing::TestParamInfo<SteadyScene>& info) {
 
 // With Coulomb friction: the frictional solver (resolution/ledas/frictional_solver.hpp) from its warm
 // start, polished by Newton steps where it does not solve at once, in each island's buffers. Newton's
-// systems of more than FrictionalSettings::dense_limit rows (96) are factorized by Eigen's SparseLU, which
-// allocates: these islands are kept below it (a pyramid of 10 rows, 300 rows, is not; README.md).
+// systems of more than FrictionalSettings::dense_limit rows (96) where no contact slides are the symmetric
+// LDLᵀ on W's kept analysis, which does not allocate (the pyramid of 10 rows, 300 rows); where a contact
+// slides they are factorized by Eigen's SparseLU, which allocates (README.md).
 INSTANTIATE_TEST_SUITE_P(
     Frictional, SteadyState,
     testing::Values(
         // A pyramid of 10 spheres at rest with μ = 0.7 (every contact sticks).
         SteadyScene{"pyramid_4_mu0.7", kModules + "generators:\n  - pyramid: {rows: 4, radius: 0.5, friction: 0.7}\n"},
+        // The pyramid of 55 spheres at rest with μ = 0.7: 300 rows, above dense_limit; Newton's steps, where
+        // every contact sticks, are the symmetric LDLᵀ on W's kept analysis.
+        SteadyScene{"pyramid_10_mu0.7", kModules + "generators:\n  - pyramid: {rows: 10, radius: 0.5, friction: 0.7}\n"},
         // Five unit boxes stacked on the ground with μ = 0.5: four contacts per face, more rows than
         // degrees of freedom (a redundant contact set; the warm start needs Newton's polish).
         SteadyScene{"stack_5_mu0.5", kModules + box_stack(5, 0.5)}),
