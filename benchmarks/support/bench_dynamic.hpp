@@ -20,7 +20,7 @@
 ///   placed at rest on the ground; the snapshot at 0.02 s. One island whose contacts all persist, the
 ///   large single system of the set (K = 100: 5,050 spheres, 14,950 contacts).
 ///
-/// With friction μ (…_mu0.5) every body, ground and wall included, gets μ.
+/// With friction μ (…_mu0.5, …_mu0.7) every body, ground and wall included, gets μ.
 
 #include "support/bench_resolvers.hpp"
 
