@@ -31,6 +31,7 @@
 #include <cstdlib>
 #include <map>
 #include <memory>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -132,9 +133,10 @@ void step(benchmark::State& state, const std::string& resolver_name, Scene scene
 // running simulation; the resolver keeps what it learnt in the previous iteration, as it would from the
 // previous step (an untimed first pass from the snapshot fills it, so that no timed iteration pays for a
 // start from nothing: the frictional pyramid's first solve is an interior-point solve of seconds, its
-// later ones a Newton step from the warm start). Counters are per step: step_ms and the stages, contacts, islands, rounds; residual,
-// natural_map and penetration (deepest contact a detection found) are the largest over the steps, and
-// energy_change the kinetic energy the resolve stage changed per step (J).
+// later ones a Newton step from the warm start). Counters are per step: step_ms and the stages,
+// contacts, islands, rounds; residual, natural_map and penetration (deepest contact a detection found)
+// are the largest over the steps, and energy_change the kinetic energy the resolve stage changed per
+// step (J).
 constexpr int kDynamicSteps = 5;
 
 const std::vector<RigidBody>& snapshot(const std::string& family, int n, double mu) {
@@ -218,8 +220,10 @@ void register_dynamic(long max_bodies) {
     if ((pyramid ? row.n * (row.n + 1) / 2 : row.n) > max_bodies ||
         (row.family == std::string("knocked_wall") && row.n >= 1000 && !slow))
       continue;
-    const std::string scene =
-        std::string(row.family) + "_" + std::to_string(row.n) + (row.mu > 0 ? row.mu == 0.5 ? "_mu0.5" : "_mu0.7" : "");
+    std::ostringstream scene_name;  // "pyramid_100_mu0.7": μ as written in the row
+    scene_name << row.family << '_' << row.n;
+    if (row.mu > 0) scene_name << "_mu" << row.mu;
+    const std::string scene = scene_name.str();
     for (const std::string resolver : {"ledas", "mirtich"})
       for (std::uint32_t threads : {1u, 2u}) {
         // mirtich is serial (only the detector would split), and with friction it takes seconds per step
