@@ -118,6 +118,29 @@ TEST(LedasFriction, MirrorSymmetricProblemGivesMirrorSymmetricImpulses) {
 // freedom) with random velocities from `random`, as a frictional problem with μ = 0.2 (small enough
 // for the solution to be unique: at μ = 0.4 one draw in twenty has two Coulomb solutions). Each
 // contact's tangent pair is turned about its normal by turn[k]; `rows` are the problem's rows.
+// The frictional problem of `rows` (three per contact: normal, t1, t2) on `bodies`, every contact with
+// coefficient μ, solved to `tolerance`: W (from the rows' couplings) into `w`, q the rows' velocities.
+ledas::FrictionalProblem frictional_problem(const std::vector<resolution::ImpulseRow>& rows,
+                                            const std::vector<RigidBody>& bodies, double mu, double tolerance,
+                                            ledas::SparseMatrix& w) {
+  const auto m = static_cast<Eigen::Index>(rows.size());
+  Eigen::MatrixXd dense(m, m);
+  for (Eigen::Index i = 0; i < m; ++i)
+    for (Eigen::Index k = 0; k < m; ++k)
+      dense(i, k) = resolution::coupling(rows[static_cast<std::size_t>(i)], rows[static_cast<std::size_t>(k)]);
+  w = dense.sparseView();
+  ledas::FrictionalProblem problem;
+  problem.w = &w;
+  problem.q.resize(m);
+  for (Eigen::Index i = 0; i < m; ++i) problem.q(i) = resolution::row_velocity(rows[static_cast<std::size_t>(i)], bodies);
+  for (Eigen::Index i = 0; i < m; i += 3) {
+    problem.role.insert(problem.role.end(), {ledas::RowRole::normal, ledas::RowRole::tangent, ledas::RowRole::tangent});
+    problem.mu.insert(problem.mu.end(), {mu, 0.0, 0.0});
+  }
+  problem.tolerance = tolerance;
+  return problem;
+}
+
 struct SphereCluster {
   std::vector<RigidBody> bodies{ground_plane(), sphere(0.5, 1.0, Vec3(0, 0, 0.5)), sphere(0.5, 2.0, Vec3(1, 0, 0.5)),
                                 sphere(0.5, 1.5, Vec3(0.5, 0, 0.5 + std::sqrt(0.75)))};
@@ -148,21 +171,7 @@ struct SphereCluster {
       const Vec3 s1 = std::cos(turn[k]) * t1 + std::sin(turn[k]) * t2, s2 = n.cross(s1);
       for (const Vec3& d : {n, s1, s2}) rows.push_back(resolution::make_row(bodies, pairs[k].a, pairs[k].b, point, d));
     }
-    const auto m = static_cast<Eigen::Index>(rows.size());
-    Eigen::MatrixXd dense(m, m);
-    for (Eigen::Index i = 0; i < m; ++i)
-      for (Eigen::Index k = 0; k < m; ++k) dense(i, k) = resolution::coupling(rows[static_cast<std::size_t>(i)], rows[static_cast<std::size_t>(k)]);
-    w = dense.sparseView();
-    ledas::FrictionalProblem problem;
-    problem.w = &w;
-    problem.q.resize(m);
-    for (Eigen::Index i = 0; i < m; ++i) problem.q(i) = resolution::row_velocity(rows[static_cast<std::size_t>(i)], bodies);
-    for (Eigen::Index i = 0; i < m; i += 3) {
-      problem.role.insert(problem.role.end(), {ledas::RowRole::normal, ledas::RowRole::tangent, ledas::RowRole::tangent});
-      problem.mu.insert(problem.mu.end(), {0.2, 0.0, 0.0});
-    }
-    problem.tolerance = 1e-13;
-    return problem;
+    return frictional_problem(rows, bodies, 0.2, 1e-13, w);
   }
 };
 
@@ -265,21 +274,9 @@ TEST(LedasFriction, NewtonSolvesAStickingColumnFromAWrongWarmStartInTwoSteps) {
       rows.push_back(resolution::make_row(bodies, static_cast<BodyIndex>(c), static_cast<BodyIndex>(c + 1),
                                           Vec3(0, 0, c), d));
   }
+  ledas::SparseMatrix w;
+  ledas::FrictionalProblem problem = frictional_problem(rows, bodies, 0.7, 1e-12, w);
   const auto m = static_cast<Eigen::Index>(rows.size());
-  Eigen::MatrixXd dense(m, m);
-  for (Eigen::Index i = 0; i < m; ++i)
-    for (Eigen::Index k = 0; k < m; ++k)
-      dense(i, k) = resolution::coupling(rows[static_cast<std::size_t>(i)], rows[static_cast<std::size_t>(k)]);
-  const ledas::SparseMatrix w = dense.sparseView();
-  ledas::FrictionalProblem problem;
-  problem.w = &w;
-  problem.q.resize(m);
-  for (Eigen::Index i = 0; i < m; ++i) problem.q(i) = resolution::row_velocity(rows[static_cast<std::size_t>(i)], bodies);
-  for (int c = 0; c < kSpheres; ++c) {
-    problem.role.insert(problem.role.end(), {ledas::RowRole::normal, ledas::RowRole::tangent, ledas::RowRole::tangent});
-    problem.mu.insert(problem.mu.end(), {0.7, 0.0, 0.0});
-  }
-  problem.tolerance = 1e-12;
   ledas::Vector expected = ledas::Vector::Zero(m);
   for (int c = kSpheres - 2; c >= 0; --c) expected(3 * c) = (c + 1 < kSpheres - 1 ? expected(3 * (c + 1)) : 0.0) + 1.0 + 0.1 * c;
   ledas::Vector start = 0.9 * expected;
