@@ -130,6 +130,14 @@ struct FclDetector::Impl {
   // every thread count. The scratch is the chunk's, not the thread's: the same pairs find buffers of the
   // sizes they needed at the last step, whichever thread runs them, so a stable scene allocates nothing.
   struct Worker {
+    // Room for the most points a pair of boxes gives before its manifold is reduced (a face clipped by a
+    // face: 4 + 4), so that a stack whose faces slide a little against each other, giving 4 points one
+    // step and 5 the next, does not grow the buffers in its steady state.
+    static constexpr std::size_t kBoxPairPoints = 8;
+    Worker() {
+      points.reserve(kBoxPairPoints);
+      speculative_points.reserve(kBoxPairPoints);
+    }
     PairSettings pair;
     std::vector<ManifoldPoint> points;
     std::vector<ManifoldPoint> speculative_points;  // a speculative pair's contacts while it is advanced

@@ -5,10 +5,9 @@
 // the problem becomes min ½ xᵀP x + cᵀx, x ∈ Q × … × ℝ₊ × … × ℝ (free joint rows), P = D⁻¹WD⁻¹,
 // c = D⁻¹q, with the multiplier z = P x + c (= D⁻¹u) in the same cones and x ∘ z = 0 (Jordan product:
 // x ∘ z = (xᵀz, x₀ z₁ + z₀ x₁)). Each step scales both by Nesterov–Todd's T (T x = T⁻¹ z = λ) and solves
-// (P + T²) Δx = rhs, symmetric positive definite (T² is, on every row but the joint rows), by sparse LDLᵀ.
+// (P + T²) Δx = rhs, symmetric positive definite (T² is, on every row but the joint rows), by the sparse
+// LDLᵀ of the frictionless solver (MaskedLdlt: one analysis while W's pattern holds, parallel subtrees).
 #include "cone_qp.hpp"
-
-#include <Eigen/SparseCholesky>
 
 #include <algorithm>
 #include <cmath>
@@ -25,19 +24,8 @@ constexpr double kStepToBoundary = 0.99;
 // would leave P + T² singular there.
 constexpr double kFreeShift = 1e-12;
 
-// One cone: rows first .. first + size − 1 of x.
-struct Cone {
-  Eigen::Index first = 0;
-  int size = 1;       // 1: ℝ₊ (or ℝ when free), 3: Q
-  bool free = false;  // a joint row: no cone, z = 0
-};
-
-// Per cone and step: Nesterov–Todd's scaling T (symmetric), T², T⁻¹ and λ = T x.
-struct Scaling {
-  Eigen::Matrix3d t, t2, inverse;
-  Eigen::Vector3d lambda;
-};
-
+using Cone = ConeQpWorkspace::Cone;
+using Scaling = ConeQpWorkspace::Scaling;
 using Vec3d = Eigen::Vector3d;
 
 Vec3d block(const Vector& v, const Cone& k) {
@@ -97,22 +85,24 @@ Scaling nesterov_todd(const Vec3d& x, const Vec3d& z, int size) {
   return s;
 }
 
-// The largest α with x + α d in the cone (∞ if every α is), x in its interior.
+// The largest α with x + α d in the cone (∞ if every α is), x in its interior. The half-space x₀ ≥ 0
+// bounds it too: the quadratic below is also positive on −Q, and for a line through the apex (or next to
+// it) its discriminant rounds below 0, which alone would let the step cross into −Q.
 double step_to_boundary(const Vec3d& x, const Vec3d& d, int size) {
   constexpr double kInfinity = std::numeric_limits<double>::infinity();
-  if (size == 1) return d(0) < 0.0 ? -x(0) / d(0) : kInfinity;
+  const double apex = d(0) < 0.0 ? -x(0) / d(0) : kInfinity;
+  if (size == 1) return apex;
   // (x₀ + α d₀)² − ‖x₁ + α d₁‖² = a α² + b α + c, c > 0: the first positive root, if any.
   const double a = d(0) * d(0) - d(1) * d(1) - d(2) * d(2);
   const double b = 2.0 * (x(0) * d(0) - x(1) * d(1) - x(2) * d(2));
   const double c = x(0) * x(0) - x(1) * x(1) - x(2) * x(2);
-  if (a == 0.0) return b < 0.0 ? -c / b : kInfinity;
+  if (a == 0.0) return std::min(apex, b < 0.0 ? -c / b : kInfinity);
   const double discriminant = b * b - 4.0 * a * c;
-  if (discriminant < 0.0) return kInfinity;  // a > 0 here: the quadratic stays positive
+  if (discriminant < 0.0) return apex;  // a > 0 here: the quadratic stays positive
   const double h = -0.5 * (b + std::copysign(std::sqrt(discriminant), b));
-  double best = kInfinity;
+  double best = apex;
   for (const double root : {h / a, h != 0.0 ? c / h : kInfinity})
     if (root > 0.0) best = std::min(best, root);
-  // A root behind the apex of −Q (x₀ + α d₀ < 0 there) is not reached through Q; the first is.
   return best;
 }
 
@@ -127,18 +117,69 @@ double max_step(const std::vector<Cone>& cones, const Vector& x, const Vector& d
   return alpha;
 }
 
+// h's pattern (W's, with every cone's diagonal block) and where W's entries and the blocks are stored in
+// it; rebuilt (allocating) only when W's pattern changed or a cone's block is not in h. The LDLᵀ's
+// analysis is redone only when h's pattern changed.
+void prepare_pattern(const SparseMatrix& w, ConeQpWorkspace& ws) {
+  const Eigen::Index m = w.rows();
+  const auto position = [&ws](Eigen::Index row, Eigen::Index col) -> SparseIndex {
+    const SparseIndex* inner = ws.h.innerIndexPtr();
+    const SparseIndex *begin = inner + ws.h.outerIndexPtr()[col], *end = inner + ws.h.outerIndexPtr()[col + 1];
+    const SparseIndex* it = std::lower_bound(begin, end, static_cast<SparseIndex>(row));
+    return it != end && *it == row ? static_cast<SparseIndex>(it - inner) : -1;
+  };
+  const auto locate_blocks = [&] {
+    ws.block.clear();
+    for (const Cone& k : ws.cones)
+      for (int a = 0; a < k.size; ++a)
+        for (int b = 0; b < k.size; ++b) {
+          const SparseIndex at = position(k.first + a, k.first + b);
+          if (at < 0) return false;
+          ws.block.push_back(at);
+        }
+    return true;
+  };
+  const bool same_w = ws.h.rows() == m && ws.outer.size() == static_cast<std::size_t>(m) + 1 &&
+                      std::equal(ws.outer.begin(), ws.outer.end(), w.outerIndexPtr()) &&
+                      ws.inner.size() == static_cast<std::size_t>(w.nonZeros()) &&
+                      std::equal(ws.inner.begin(), ws.inner.end(), w.innerIndexPtr());
+  if (!same_w || !locate_blocks()) {
+    std::vector<Eigen::Triplet<double>> entries;
+    entries.reserve(static_cast<std::size_t>(w.nonZeros()) + 9 * ws.cones.size());
+    for (Eigen::Index col = 0; col < m; ++col)
+      for (SparseMatrix::InnerIterator it(w, col); it; ++it) entries.emplace_back(it.row(), col, 0.0);
+    for (const Cone& k : ws.cones)
+      for (int a = 0; a < k.size; ++a)
+        for (int b = 0; b < k.size; ++b) entries.emplace_back(k.first + a, k.first + b, 0.0);
+    ws.h.resize(m, m);
+    ws.h.setFromTriplets(entries.begin(), entries.end());
+    ws.h.makeCompressed();
+    ws.from_w.clear();
+    for (Eigen::Index col = 0; col < m; ++col)
+      for (SparseMatrix::InnerIterator it(w, col); it; ++it) ws.from_w.push_back(position(it.row(), col));
+    ws.outer.assign(w.outerIndexPtr(), w.outerIndexPtr() + m + 1);
+    ws.inner.assign(w.innerIndexPtr(), w.innerIndexPtr() + w.nonZeros());
+    locate_blocks();
+  }
+  if (!ws.ldlt.same_pattern(ws.h)) ws.ldlt.analyze(ws.h);
+  ws.every_row.assign(static_cast<std::size_t>(m), 1);
+}
+
 }  // namespace
 
-Vector solve_cone_qp(const FrictionalProblem& problem, double target, std::uint64_t max_iterations,
-                     ConeQpReport& report) {
+void solve_cone_qp(const FrictionalProblem& problem, double target, std::uint64_t max_iterations,
+                   ConeQpWorkspace& ws, Vector& result, ConeQpReport& report) {
   const SparseMatrix& w = *problem.w;
   const Eigen::Index m = problem.q.size();
   report = {};
-  if (m == 0) return Vector();
+  result.setZero(m);
+  if (m == 0) return;
 
   // The cones and the scaling D.
-  std::vector<Cone> cones;
-  Vector d = Vector::Ones(m);
+  std::vector<Cone>& cones = ws.cones;
+  cones.clear();
+  Vector& d = ws.d;
+  d.setOnes(m);
   std::size_t degree = 0;  // ν: the number of cones (the barrier's degree)
   for (Eigen::Index i = 0; i < m;) {
     const auto row = static_cast<std::size_t>(i);
@@ -153,36 +194,35 @@ Vector solve_cone_qp(const FrictionalProblem& problem, double target, std::uint6
     cones.push_back(k);
     i += k.size;
   }
-  SparseMatrix p = w;
-  for (Eigen::Index col = 0; col < p.outerSize(); ++col)
-    for (SparseMatrix::InnerIterator it(p, col); it; ++it) it.valueRef() /= d(it.row()) * d(col);
-  const Vector c = problem.q.cwiseQuotient(d);
-  const double p_scale = std::max(p.diagonal().maxCoeff(), std::numeric_limits<double>::min());
+  prepare_pattern(w, ws);
+  // P = D⁻¹ W D⁻¹ is not formed: its values go into h, and P x = D⁻¹ W (D⁻¹ x).
+  double p_scale = std::numeric_limits<double>::min();
+  for (Eigen::Index i = 0; i < m; ++i) p_scale = std::max(p_scale, w.coeff(i, i) / (d(i) * d(i)));
+  Vector& c = ws.c;
+  c = problem.q.cwiseQuotient(d);
   const double c_scale = std::max(c.lpNorm<Eigen::Infinity>(), std::numeric_limits<double>::min());
 
   // Start at the cones' centres e = (1, 0, 0), sized to the problem: x ~ impulses, z ~ velocities.
-  Vector x = Vector::Zero(m), z = Vector::Zero(m);
+  Vector &x = ws.x, &z = ws.z, &r = ws.r, &best = ws.best, &rd = ws.rd;
+  x.setZero(m);
+  z.setZero(m);
   for (const Cone& k : cones)
     if (!k.free) {
       x(k.first) = c_scale / p_scale;
       z(k.first) = c_scale;
     }
 
-  // The pattern of P + T² (P's and each cone's diagonal block, explicit zeros kept) is the same at every
-  // step: one symbolic analysis.
-  std::vector<Eigen::Triplet<double>> entries;
-  Eigen::SimplicialLDLT<SparseMatrix, Eigen::Lower> ldlt;
-  bool analyzed = false;
-  std::vector<Scaling> scaling(cones.size());
-  Vector r = Vector::Zero(m);
-  Vector best = r;
+  std::vector<Scaling>& scaling = ws.scaling;
+  scaling.resize(cones.size());
+  std::vector<Vec3d>& eta = ws.eta;
+  best.setZero(m);
   double best_residual = std::numeric_limits<double>::infinity();
-  FrictionalProblem relaxed = problem;
-  relaxed.convex = true;
+  double* const h = ws.h.valuePtr();
+  const double* const w_value = w.valuePtr();
 
   for (; report.iterations < max_iterations; ++report.iterations) {
     r = x.cwiseQuotient(d);
-    const double residual = natural_map_residual(relaxed, r);
+    const double residual = natural_map_residual(problem, r);
     if (residual < best_residual) {
       best_residual = residual;
       best = r;
@@ -191,21 +231,24 @@ Vector solve_cone_qp(const FrictionalProblem& problem, double target, std::uint6
       report.converged = true;
       break;
     }
-    const Vector rd = p * x + c - z;  // the dual residual (z = 0 on joint rows)
+    rd.noalias() = w * r;  // the dual residual P x + c − z (z = 0 on joint rows)
+    rd = rd.cwiseQuotient(d) + c - z;
     double gap = 0.0;
     for (const Cone& k : cones)
       if (!k.free) gap += block(x, k).dot(block(z, k));
     const double mu = degree > 0 ? gap / static_cast<double>(degree) : 0.0;
 
-    entries.clear();
+    // h = P + T² (and the joint rows' shift) on its kept pattern.
+    std::fill(h, h + ws.h.nonZeros(), 0.0);
+    for (Eigen::Index col = 0, e = 0; col < m; ++col)
+      for (SparseMatrix::InnerIterator it(w, col); it; ++it, ++e)
+        h[ws.from_w[static_cast<std::size_t>(e)]] = w_value[e] / (d(it.row()) * d(col));
     bool numerical_end = false;
-    for (Eigen::Index col = 0; col < p.outerSize(); ++col)
-      for (SparseMatrix::InnerIterator it(p, col); it; ++it)
-        if (it.row() >= col) entries.emplace_back(it.row(), col, it.value());
+    std::size_t entry = 0;
     for (std::size_t n = 0; n < cones.size(); ++n) {
       const Cone& k = cones[n];
       if (k.free) {
-        entries.emplace_back(k.first, k.first, kFreeShift * p_scale);
+        h[ws.block[entry++]] += kFreeShift * p_scale;
         continue;
       }
       scaling[n] = nesterov_todd(block(x, k), block(z, k), k.size);
@@ -214,29 +257,22 @@ Vector solve_cone_qp(const FrictionalProblem& problem, double target, std::uint6
         break;
       }
       for (int a = 0; a < k.size; ++a)
-        for (int b = 0; b <= a; ++b) entries.emplace_back(k.first + a, k.first + b, scaling[n].t2(a, b));
+        for (int b = 0; b < k.size; ++b) h[ws.block[entry++]] += scaling[n].t2(a, b);
     }
     if (numerical_end) break;
-    SparseMatrix h(m, m);
-    h.setFromTriplets(entries.begin(), entries.end());
-    if (!analyzed) {
-      ldlt.analyzePattern(h);
-      analyzed = true;
-    }
-    ldlt.factorize(h);
-    if (ldlt.info() != Eigen::Success) break;
+    ws.ldlt.factorize(ws.h, ws.every_row, 0.0, 0.0);
 
     // (P + T²) Δx = −r_d + T η,  Δz = T η − T² Δx,  with λ ∘ η = ξ per cone.
-    const auto direction = [&](const std::vector<Vec3d>& eta, Vector& dx, Vector& dz) {
-      Vector rhs = -rd;
+    const auto direction = [&](Vector& dx, Vector& dz) {
+      dx = -rd;
       for (std::size_t n = 0; n < cones.size(); ++n) {
         const Cone& k = cones[n];
         if (k.free) continue;
         const Vec3d te = scaling[n].t * eta[n];
-        for (int a = 0; a < k.size; ++a) rhs(k.first + a) += te(a);
+        for (int a = 0; a < k.size; ++a) dx(k.first + a) += te(a);
       }
-      dx = ldlt.solve(rhs);
-      dz = Vector::Zero(m);
+      ws.ldlt.solve(dx);
+      dz.setZero(m);
       for (std::size_t n = 0; n < cones.size(); ++n) {
         const Cone& k = cones[n];
         if (k.free) continue;
@@ -245,11 +281,11 @@ Vector solve_cone_qp(const FrictionalProblem& problem, double target, std::uint6
       }
     };
     // Predictor (affine scaling): ξ = −λ ∘ λ, so η = −λ.
-    std::vector<Vec3d> eta(cones.size(), Vec3d::Zero());
+    eta.assign(cones.size(), Vec3d::Zero());
     for (std::size_t n = 0; n < cones.size(); ++n)
       if (!cones[n].free) eta[n] = -scaling[n].lambda;
-    Vector dx_aff, dz_aff;
-    direction(eta, dx_aff, dz_aff);
+    Vector &dx_aff = ws.dx_aff, &dz_aff = ws.dz_aff;
+    direction(dx_aff, dz_aff);
     if (!dx_aff.allFinite()) break;
     const double alpha_aff = std::min(1.0, max_step(cones, x, dx_aff, z, dz_aff));
     double gap_aff = 0.0;
@@ -267,8 +303,8 @@ Vector solve_cone_qp(const FrictionalProblem& problem, double target, std::uint6
       xi(0) += sigma * mu;
       eta[n] = jordan_divide(s.lambda, xi, k.size);
     }
-    Vector dx, dz;
-    direction(eta, dx, dz);
+    Vector &dx = ws.dx, &dz = ws.dz;
+    direction(dx, dz);
     if (!dx.allFinite() || !dz.allFinite()) break;
     const double alpha = std::min(1.0, kStepToBoundary * max_step(cones, x, dx, z, dz));
     x += alpha * dx;
@@ -276,9 +312,9 @@ Vector solve_cone_qp(const FrictionalProblem& problem, double target, std::uint6
   }
   if (!report.converged) {
     r = x.cwiseQuotient(d);
-    if (natural_map_residual(relaxed, r) < best_residual) best = r;
+    if (natural_map_residual(problem, r) < best_residual) best = r;
   }
-  return best;
+  result = best;
 }
 
 }  // namespace impetus::ledas

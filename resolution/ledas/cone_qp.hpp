@@ -11,8 +11,12 @@
 // the redundancy of the contacts (W singular: the iterates approach the centre of the solution set, so a
 // symmetric problem gets a symmetric answer), where Newton on the natural map stalls.
 #include "impetus/resolution/ledas/frictional_solver.hpp"
+#include "impetus/resolution/ledas/masked_ldlt.hpp"
+
+#include <Eigen/Core>
 
 #include <cstdint>
+#include <vector>
 
 namespace impetus::ledas {
 
@@ -21,10 +25,36 @@ struct ConeQpReport {
   bool converged = false;        // the duality measure and the velocity residual fell below the tolerance
 };
 
-/// The relaxation's impulses r (size m): the iterate with the smallest natural-map residual of the
-/// relaxation, stopping when it is ≤ `target` or after `max_iterations` steps (the caller then polishes it
-/// with Newton on the natural map).
-Vector solve_cone_qp(const FrictionalProblem& problem, double target, std::uint64_t max_iterations,
-                     ConeQpReport& report);
+/// The interior point's buffers, kept by the caller (FrictionalWorkspace): solving problems whose W has
+/// the pattern of the last one, with the same cones, allocates nothing; the LDLᵀ's analysis is kept.
+struct ConeQpWorkspace {
+  // One cone: rows first .. first + size − 1 of x.
+  struct Cone {
+    Eigen::Index first = 0;
+    int size = 1;       // 1: ℝ₊ (or ℝ when free), 3: Q
+    bool free = false;  // a joint row: no cone, z = 0
+  };
+  // Per cone and step: Nesterov–Todd's scaling T (symmetric), T², T⁻¹ and λ = T x.
+  struct Scaling {
+    Eigen::Matrix3d t, t2, inverse;
+    Eigen::Vector3d lambda;
+  };
+  std::vector<Cone> cones;
+  std::vector<Scaling> scaling;
+  std::vector<Eigen::Vector3d> eta;
+  // P + T² on the pattern of W with every cone's diagonal block; where W's entry e and cone n's entry
+  // (a, b) are stored in it (`from_w`, `block`: 9 per cone, row-major), for W's pattern `outer`, `inner`.
+  SparseMatrix h;
+  std::vector<SparseIndex> from_w, block, outer, inner;
+  std::vector<char> every_row;
+  MaskedLdlt ldlt;
+  Vector d, c, x, z, r, best, rd, dx_aff, dz_aff, dx, dz;
+};
+
+/// Into r (size m): the relaxation's impulses, the iterate with the smallest natural-map residual of the
+/// relaxation (`problem` is the relaxation: `convex`), stopping when it is ≤ `target` or after
+/// `max_iterations` steps (the caller then polishes it with Newton on the natural map).
+void solve_cone_qp(const FrictionalProblem& problem, double target, std::uint64_t max_iterations,
+                   ConeQpWorkspace& workspace, Vector& r, ConeQpReport& report);
 
 }  // namespace impetus::ledas

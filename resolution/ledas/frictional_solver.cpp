@@ -75,6 +75,13 @@ struct FrictionalWorkspace::Newton {
   MaskedLdlt ldlt;
   std::vector<char> active;
   Vector rhs;
+  // The cold path's (solve, solve_stages, proximal_newton): kept so that a cold solve of a problem with
+  // the last one's pattern allocates nothing either (where no contact slides above `dense_limit`).
+  ConeQpWorkspace cone_qp;
+  std::vector<Block> stage_blocks;
+  Vector stage_diagonal, stage_best, cold_best, polished, velocity, next;
+  FrictionalProblem relaxed, sub, exact;
+  SparseMatrix shifted;
 };
 
 FrictionalWorkspace::FrictionalWorkspace() = default;
@@ -124,12 +131,6 @@ void make_blocks(const FrictionalProblem& problem, const Vector& diagonal, std::
     blocks.push_back(b);
     i += b.size;
   }
-}
-
-std::vector<Block> make_blocks(const FrictionalProblem& problem, const Vector& diagonal) {
-  std::vector<Block> blocks;
-  make_blocks(problem, diagonal, blocks);
-  return blocks;
 }
 
 // The relaxation's block of F = r − P_K(z), z = r − ρ u, and its piece.
@@ -543,17 +544,19 @@ double FrictionalSolver::newton(const FrictionalProblem& problem, const std::vec
 // the Jacobian's own shift), ×10 after one it could not (up to 0.1 max W_ii: a better conditioned
 // subproblem, a slower but surer outer iteration). Each subproblem is solved only to a fraction of the
 // current error (an inexact proximal point method), the last ones to the tolerance.
-Vector FrictionalSolver::proximal_newton(const FrictionalProblem& problem, const std::vector<Block>& blocks, Vector r,
-                                         FrictionalStats& stats) {
+void FrictionalSolver::proximal_newton(const FrictionalProblem& problem, const std::vector<Block>& blocks, Vector& r,
+                                       FrictionalStats& stats) {
   const double scale = problem.w->diagonal().maxCoeff();
   const double floor = settings_.regularization * scale, ceiling = 0.1 * scale;
   double epsilon = settings_.proximal * scale;
   double residual = natural_map_residual(problem, r);
-  SparseMatrix shifted;
+  SparseMatrix& shifted = buffers_->shifted;
   double shifted_by = -1.0;
-  FrictionalProblem sub;
+  FrictionalProblem& sub = buffers_->sub;
   sub.role = problem.role;
   sub.mu = problem.mu;
+  sub.workspace = problem.workspace;
+  Vector& next = buffers_->next;
   for (std::uint64_t outer = 0; outer < settings_.proximal_iterations && residual > problem.tolerance && steps_left_ > 0;
        ++outer) {
     ++stats.proximal_steps;
@@ -565,7 +568,7 @@ Vector FrictionalSolver::proximal_newton(const FrictionalProblem& problem, const
     sub.w = &shifted;
     sub.q = problem.q - epsilon * r;
     sub.tolerance = std::max(0.5 * problem.tolerance, 1e-3 * residual);
-    Vector next = r;
+    next = r;
     if (newton(sub, blocks, next, settings_.proximal_newton_iterations, stats) <= sub.tolerance) {
       r = next;
       residual = natural_map_residual(problem, r);
@@ -574,7 +577,6 @@ Vector FrictionalSolver::proximal_newton(const FrictionalProblem& problem, const
       epsilon = std::min(10.0 * epsilon, ceiling);
     }
   }
-  return r;
 }
 
 Vector FrictionalSolver::solve(const FrictionalProblem& problem, FrictionalStats& stats) {
@@ -619,7 +621,9 @@ void FrictionalSolver::solve(const FrictionalProblem& problem, FrictionalStats& 
     // 1. The convex relaxation: among Coulomb's solutions of a redundant problem it picks the one a
     //    static equilibrium gives, whenever one exists (velocities 0 where the relaxation's are, see
     //    the header), and its answer is Coulomb's wherever no pressed contact slips.
-    FrictionalProblem relaxed = problem;
+    FrictionalWorkspace::Newton& buffers = *buffers_;
+    FrictionalProblem& relaxed = buffers.relaxed;
+    relaxed = problem;  // the vectors' storage reused
     relaxed.convex = true;
     relaxed.start = nullptr;
     ++stats.relaxed;
@@ -631,22 +635,26 @@ void FrictionalSolver::solve(const FrictionalProblem& problem, FrictionalStats& 
     //    relaxation again with q_n raised by s = μ‖u_t‖ of the last answer (a fixed point is a Coulomb
     //    solution), each answer again a start for Newton. On the collapsing sphere pyramid further
     //    fixed-point steps oscillated (damped too), so by default one is taken.
-    const std::vector<Block> blocks = make_blocks(problem, problem.w->diagonal());
-    Vector best = r;
+    buffers.diagonal = problem.w->diagonal();
+    make_blocks(problem, buffers.diagonal, buffers.blocks);
+    const std::vector<Block>& blocks = buffers.blocks;
+    Vector &best = buffers.cold_best, &polished = buffers.polished, &u = buffers.velocity;
+    best = r;
     double best_residual = residual;
     for (std::uint64_t k = 0; k < settings_.fixed_point_iterations && best_residual > problem.tolerance &&
                               relaxed_residual <= relaxed.tolerance;
          ++k) {
       ++stats.fixed_point_steps;
       steps_left_ = settings_.polish_newton_iterations;
-      Vector polished = r;
+      polished = r;
       if (const double now = newton(problem, blocks, polished, settings_.polish_newton_iterations, stats);
           now < best_residual) {
         best_residual = now;
         best = polished;
       }
       if (best_residual <= problem.tolerance) break;
-      const Vector u = *problem.w * r + problem.q;
+      u.noalias() = *problem.w * r;
+      u += problem.q;
       relaxed.q = problem.q;
       for (const Block& block : blocks)
         if (block.size == 3) relaxed.q(block.first) += block.mu * std::hypot(u(block.first + 1), u(block.first + 2));
@@ -664,7 +672,8 @@ void FrictionalSolver::solve(const FrictionalProblem& problem, FrictionalStats& 
     //    the answer is exact to rounding, not just to the tolerance, and does not depend on which stage
     //    found it (a slope turned about its normal gives the same slip to 1e-12).
     if (!relaxation_solves && residual <= problem.tolerance && residual > 0.0) {
-      FrictionalProblem exact = problem;
+      FrictionalProblem& exact = buffers.exact;
+      exact = problem;
       exact.tolerance = 0.0;
       steps_left_ = settings_.refinement_steps;
       residual = newton(exact, blocks, r, settings_.refinement_steps, stats);
@@ -678,8 +687,10 @@ void FrictionalSolver::solve(const FrictionalProblem& problem, FrictionalStats& 
 // its natural-map residual.
 double FrictionalSolver::solve_stages(const FrictionalProblem& problem, Vector& r, bool warm, FrictionalStats& stats) {
   const SparseMatrix& w = *problem.w;
-  const Vector diagonal = w.diagonal();
-  const std::vector<Block> blocks = make_blocks(problem, diagonal);
+  FrictionalWorkspace::Newton& buffers = *buffers_;
+  const Vector& diagonal = buffers.stage_diagonal = w.diagonal();
+  make_blocks(problem, diagonal, buffers.stage_blocks);
+  const std::vector<Block>& blocks = buffers.stage_blocks;
   steps_left_ = settings_.max_newton_steps;
 
   // 1. Newton on the problem itself: enough whenever W is well conditioned on the contacts that end up
@@ -690,7 +701,7 @@ double FrictionalSolver::solve_stages(const FrictionalProblem& problem, Vector& 
     // The relaxation is a convex cone program: an interior-point method solves it whatever the
     // redundancy, and Newton polishes its answer.
     ConeQpReport report;
-    r = solve_cone_qp(problem, problem.tolerance, settings_.interior_point_iterations, report);
+    solve_cone_qp(problem, problem.tolerance, settings_.interior_point_iterations, buffers.cone_qp, r, report);
     stats.interior_point_steps += report.iterations;
     residual = natural_map_residual(problem, r);
     warm = polish = true;
@@ -701,11 +712,13 @@ double FrictionalSolver::solve_stages(const FrictionalProblem& problem, Vector& 
   // 2. Redundant contacts or a stalled Newton: proximal Newton steps (fast near a solution, and
   //    bounded along W's null space), and if they stall, a round of projected Gauss–Seidel sweeps
   //    (robust, slow; it brings the iterate nearer a solution) before the next try.
-  Vector best = r;
+  Vector& best = buffers.stage_best;
+  best = r;
   double best_residual = residual;
   for (std::uint64_t round = 0;
        round < settings_.hybrid_rounds && best_residual > problem.tolerance && steps_left_ > 0; ++round) {
-    r = proximal_newton(problem, blocks, best, stats);
+    r = best;
+    proximal_newton(problem, blocks, r, stats);
     if (const double now = natural_map_residual(problem, r); now < best_residual) {
       best_residual = now;
       best = r;

@@ -117,6 +117,21 @@ INSTANTIATE_TEST_SUITE_P(
         SteadyScene{"stack_5_mu0.5", kModules + box_stack(5, 0.5)}),
     test_name);
 
+// Without warm starts every step's frictional solve is cold: the interior point on the convex relaxation,
+// then Newton's polish, in the island's buffers, with the LDLᵀ analyses kept while W's pattern holds.
+const std::string kCold =
+    "modules: {integrator: momentum, detector: fcl, resolver: {plugin: ledas, mode: complementary, warm_start: false}}\n";
+
+INSTANTIATE_TEST_SUITE_P(
+    FrictionalCold, SteadyState,
+    testing::Values(
+        SteadyScene{"pyramid_4_mu0.7", kCold + "generators:\n  - pyramid: {rows: 4, radius: 0.5, friction: 0.7}\n"},
+        // 300 rows: the interior point's LDLᵀ and Newton's symmetric one on the sparse path.
+        SteadyScene{"pyramid_10_mu0.7", kCold + "generators:\n  - pyramid: {rows: 10, radius: 0.5, friction: 0.7}\n"},
+        // Redundant: the relaxation's answer, polished by Newton with W shifted.
+        SteadyScene{"stack_5_mu0.5", kCold + box_stack(5, 0.5)}),
+    test_name);
+
 // The sequential resolver (mirtich) keeps its buffers too: the same resting pyramid, and the stack of
 // boxes with friction (Mirtich's frictional collision integration). Not the line: a line of 100 spheres
 // is where the sequential sweep reaches its impulse cap every step (resolution/mirtich/README.md), so

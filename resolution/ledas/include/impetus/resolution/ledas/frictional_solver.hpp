@@ -154,8 +154,8 @@ class FrictionalSolver {
   double solve_stages(const FrictionalProblem& problem, Vector& r, bool warm, FrictionalStats& stats);
   double newton(const FrictionalProblem& problem, const std::vector<Block>& blocks, Vector& r,
                 std::uint64_t iterations, FrictionalStats& stats);
-  Vector proximal_newton(const FrictionalProblem& problem, const std::vector<Block>& blocks, Vector r,
-                         FrictionalStats& stats);
+  void proximal_newton(const FrictionalProblem& problem, const std::vector<Block>& blocks, Vector& r,
+                       FrictionalStats& stats);
 
   FrictionalSettings settings_;
   std::uint64_t steps_left_ = 0;  // Newton steps left to the current solve (max_newton_steps)
