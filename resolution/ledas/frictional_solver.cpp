@@ -629,7 +629,6 @@ void FrictionalSolver::solve(const FrictionalProblem& problem, FrictionalStats& 
     ++stats.relaxed;
     const double relaxed_residual = solve_stages(relaxed, r, false, stats);
     residual = natural_map_residual(problem, r);
-    const bool relaxation_solves = residual <= problem.tolerance;
     // 2. Where a pressed contact slips, the relaxation separates it at μ‖u_t‖ instead. Newton on
     //    Coulomb's problem from its answer (fast near a solution), then Cadoux's fixed point: the
     //    relaxation again with q_n raised by s = μ‖u_t‖ of the last answer (a fixed point is a Coulomb
@@ -668,10 +667,11 @@ void FrictionalSolver::solve(const FrictionalProblem& problem, FrictionalStats& 
     residual = best_residual;
     // 3. Still not solved: the stages on Coulomb's problem from the best answer.
     if (residual > problem.tolerance) residual = solve_stages(problem, r, true, stats);
-    // 4. A slipping answer: a few more Newton steps. Near a solution they converge quadratically, so
-    //    the answer is exact to rounding, not just to the tolerance, and does not depend on which stage
-    //    found it (a slope turned about its normal gives the same slip to 1e-12).
-    if (!relaxation_solves && residual <= problem.tolerance && residual > 0.0) {
+    // 4. A few more Newton steps. Near a solution they converge quadratically, so the answer is exact to
+    //    rounding, not just to the tolerance, and does not depend on which stage found it (a slope turned
+    //    about its normal gives the same slip to 1e-12; the interior point's answer on the pyramid of
+    //    K = 50 at rest goes from 1.4e-10 to 5e-13).
+    if (residual <= problem.tolerance && residual > 0.0) {
       FrictionalProblem& exact = buffers.exact;
       exact = problem;
       exact.tolerance = 0.0;

@@ -17,8 +17,9 @@
 ///     Newton on its natural map: a static equilibrium is its answer whenever one exists, and where its
 ///     answer has no pressed contact slipping it is Coulomb's answer;
 ///  2. else Newton on Coulomb's problem from it, one step of Cadoux's fixed point (the relaxation with q_n
-///     raised by μ‖u_t‖), and the stages below; a slipping answer gets a few Newton steps past the
-///     tolerance. The Newton stages: a semismooth Newton method on the Alart–Curnier function
+///     raised by μ‖u_t‖), and the stages below;
+///  3. a cold answer within the tolerance gets a few Newton steps past it (exact to rounding). The Newton
+///     stages: a semismooth Newton method on the Alart–Curnier function
 ///   F_n = r_n − max(0, z_n),  z_n = r_n − ρ_n u_n,
 ///   F_t = r_t − P_D(μ max(0, z_n)) (z_t),  z_t = r_t − ρ_t u_t,  P_D(R) the projection on the disk ‖·‖ ≤ R,
 /// whose zeros are exactly the solutions above (ρ > 0 per contact; the cone is round and ρ_t is one
@@ -95,7 +96,7 @@ struct FrictionalSettings {
   std::uint64_t fixed_point_iterations = 1;     ///< Cadoux's fixed-point steps (relaxations) at most
   std::uint64_t polish_newton_iterations = 8;   ///< Newton steps on Coulomb's problem from each of them
   std::uint64_t warm_newton_iterations = 2;     ///< Newton steps from a warm start that does not solve at once
-  std::uint64_t refinement_steps = 3;           ///< Newton steps past the tolerance on a slipping answer
+  std::uint64_t refinement_steps = 3;           ///< Newton steps past the tolerance on a cold answer
   std::uint64_t hybrid_rounds = 40;      ///< rounds of proximal Newton then Gauss–Seidel sweeps, at most
   std::uint64_t sweeps_per_round = 20;   ///< projected Gauss–Seidel sweeps per round
   double regularization = 1e-10;         ///< W's diagonal shift in the Jacobian, × max W_ii
