@@ -118,8 +118,7 @@ double max_step(const std::vector<Cone>& cones, const Vector& x, const Vector& d
 }
 
 // h's pattern (W's, with every cone's diagonal block) and where W's entries and the blocks are stored in
-// it; rebuilt (allocating) only when W's pattern changed or a cone's block is not in h. The LDLᵀ's
-// analysis is redone only when h's pattern changed.
+// it; rebuilt (allocating) only when W's pattern changed or a cone's block is not in h.
 void prepare_pattern(const SparseMatrix& w, ConeQpWorkspace& ws) {
   const Eigen::Index m = w.rows();
   const auto position = [&ws](Eigen::Index row, Eigen::Index col) -> SparseIndex {
@@ -161,14 +160,13 @@ void prepare_pattern(const SparseMatrix& w, ConeQpWorkspace& ws) {
     ws.inner.assign(w.innerIndexPtr(), w.innerIndexPtr() + w.nonZeros());
     locate_blocks();
   }
-  if (!ws.ldlt.same_pattern(ws.h)) ws.ldlt.analyze(ws.h);
   ws.every_row.assign(static_cast<std::size_t>(m), 1);
 }
 
 }  // namespace
 
 void solve_cone_qp(const FrictionalProblem& problem, double target, std::uint64_t max_iterations,
-                   ConeQpWorkspace& ws, Vector& result, ConeQpReport& report) {
+                   ConeQpWorkspace& ws, MaskedLdlt& ldlt, Vector& result, ConeQpReport& report) {
   const SparseMatrix& w = *problem.w;
   const Eigen::Index m = problem.q.size();
   report = {};
@@ -195,6 +193,7 @@ void solve_cone_qp(const FrictionalProblem& problem, double target, std::uint64_
     i += k.size;
   }
   prepare_pattern(w, ws);
+  if (!ldlt.same_pattern(ws.h)) ldlt.analyze(ws.h);
   // P = D⁻¹ W D⁻¹ is not formed: its values go into h, and P x = D⁻¹ W (D⁻¹ x).
   double p_scale = std::numeric_limits<double>::min();
   for (Eigen::Index i = 0; i < m; ++i) p_scale = std::max(p_scale, w.coeff(i, i) / (d(i) * d(i)));
@@ -260,7 +259,7 @@ void solve_cone_qp(const FrictionalProblem& problem, double target, std::uint64_
         for (int b = 0; b < k.size; ++b) h[ws.block[entry++]] += scaling[n].t2(a, b);
     }
     if (numerical_end) break;
-    ws.ldlt.factorize(ws.h, ws.every_row, 0.0, 0.0);
+    ldlt.factorize(ws.h, ws.every_row, 0.0, 0.0);
 
     // (P + T²) Δx = −r_d + T η,  Δz = T η − T² Δx,  with λ ∘ η = ξ per cone.
     const auto direction = [&](Vector& dx, Vector& dz) {
@@ -271,7 +270,7 @@ void solve_cone_qp(const FrictionalProblem& problem, double target, std::uint64_
         const Vec3d te = scaling[n].t * eta[n];
         for (int a = 0; a < k.size; ++a) dx(k.first + a) += te(a);
       }
-      ws.ldlt.solve(dx);
+      ldlt.solve(dx);
       dz.setZero(m);
       for (std::size_t n = 0; n < cones.size(); ++n) {
         const Cone& k = cones[n];

@@ -26,7 +26,7 @@ struct ConeQpReport {
 };
 
 /// The interior point's buffers, kept by the caller (FrictionalWorkspace): solving problems whose W has
-/// the pattern of the last one, with the same cones, allocates nothing; the LDLᵀ's analysis is kept.
+/// the pattern of the last one, with the same cones, allocates nothing.
 struct ConeQpWorkspace {
   // One cone: rows first .. first + size − 1 of x.
   struct Cone {
@@ -47,14 +47,16 @@ struct ConeQpWorkspace {
   SparseMatrix h;
   std::vector<SparseIndex> from_w, block, outer, inner;
   std::vector<char> every_row;
-  MaskedLdlt ldlt;
   Vector d, c, x, z, r, best, rd, dx_aff, dz_aff, dx, dz;
 };
 
 /// Into r (size m): the relaxation's impulses, the iterate with the smallest natural-map residual of the
 /// relaxation (`problem` is the relaxation: `convex`), stopping when it is ≤ `target` or after
-/// `max_iterations` steps (the caller then polishes it with Newton on the natural map).
+/// `max_iterations` steps (the caller then polishes it with Newton on the natural map). `ldlt` factorizes
+/// P + T², analysed afresh only when its pattern changed: when every cone's block lies in W's pattern
+/// (a contact's rows share W's pattern), that is W's pattern, so the caller's Newton steps on W
+/// (frictional_solver.cpp, `symmetric_direction`) share its analysis.
 void solve_cone_qp(const FrictionalProblem& problem, double target, std::uint64_t max_iterations,
-                   ConeQpWorkspace& workspace, Vector& r, ConeQpReport& report);
+                   ConeQpWorkspace& workspace, MaskedLdlt& ldlt, Vector& r, ConeQpReport& report);
 
 }  // namespace impetus::ledas

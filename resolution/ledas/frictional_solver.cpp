@@ -71,7 +71,8 @@ struct FrictionalWorkspace::Newton {
   Eigen::SparseLU<SparseMatrix, Eigen::COLAMDOrdering<int>> sparse_lu;
   std::vector<SparseMatrix::StorageIndex> analysed_outer, analysed_inner;
   // The symmetric path's (no block slides): LDLᵀ of (W + shift I) on the active rows, W's analysis kept
-  // while its pattern does not change; the active rows and the right-hand side.
+  // while its pattern does not change (and shared with the interior point's P + T², whose pattern is W's);
+  // the active rows and the right-hand side.
   MaskedLdlt ldlt;
   std::vector<char> active;
   Vector rhs;
@@ -701,7 +702,8 @@ double FrictionalSolver::solve_stages(const FrictionalProblem& problem, Vector& 
     // The relaxation is a convex cone program: an interior-point method solves it whatever the
     // redundancy, and Newton polishes its answer.
     ConeQpReport report;
-    solve_cone_qp(problem, problem.tolerance, settings_.interior_point_iterations, buffers.cone_qp, r, report);
+    solve_cone_qp(problem, problem.tolerance, settings_.interior_point_iterations, buffers.cone_qp, buffers.ldlt, r,
+                  report);
     stats.interior_point_steps += report.iterations;
     residual = natural_map_residual(problem, r);
     warm = polish = true;
