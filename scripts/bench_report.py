@@ -143,7 +143,7 @@ def paper_table(res):
 
 
 def full_table(res):
-    scenes = sorted({s for r in res.values() for s in r}, key=scene_order)
+    scenes = sorted({s for r in res.values() for s in r if "_mu" not in s}, key=scene_order)
     lines = ["| Scene | Bodies | Contacts | Resolver | Time (median) | Rounds / impulses | Pulling | "
              "Residual (m/s) | Complementarity | Exact | Not converged |",
              "|---|---:|---:|---|---:|---:|---:|---:|---:|:-:|:-:|"]
@@ -169,12 +169,51 @@ def scaling(res):
     for r, scenes in res.items():
         fam = {"pyramid": [], "line_e0": [], "line_e1": []}
         for scene, row in scenes.items():
-            if "error" in row:
+            if "error" in row or "_mu" in scene:  # the frictional rows have their own section
                 continue
             key = "pyramid" if scene.startswith("pyramid") else ("line_e1" if scene.endswith("_e1") else "line_e0")
             fam[key].append((row["contacts"], row["seconds"]))
         fits[r] = {k: fit_exponent(v) for k, v in fam.items()}
     return fits
+
+
+def friction_rows(res):
+    """[(family, μ, n, resolver, scene, row)] for the frictional rows (scene names …_mu<μ>), ordered."""
+    entries = []
+    for r, scenes in res.items():
+        for scene, row in scenes.items():
+            m = re.match(r"(pyramid|line)_(\d+)(?:_e\d)?_mu([0-9.]+)$", scene)
+            if m and "error" not in row:
+                entries.append((m.group(1) != "pyramid", -float(m.group(3)), int(m.group(2)),
+                                RESOLVERS.index(r), m.group(1), m.group(3), scene, r, row))
+    return sorted(entries)
+
+
+def friction_table(res):
+    """The frictional rows: time, fclib's natural-map error, sticking and sliding contacts, and the time
+    against the frictionless exact resolve of the same scene (ledas complementary)."""
+    lines = ["| Scene | μ | Bodies | Contacts | Resolver | Time (median) | Natural map | Sticking | Sliding | "
+             "Exact | × frictionless ledas |", "|---|---:|---:|---:|---|---:|---:|---:|---:|:-:|---:|"]
+    for *_, family, mu, scene, r, row in friction_rows(res):
+        base = res.get("ledas", {}).get(scene.rsplit("_mu", 1)[0])
+        ratio = f"{row['seconds'] / base['seconds']:,.0f}×" if base and "error" not in base else "—"
+        lines.append(f"| {scene} | {mu} | {row['bodies']:.0f} | {row['contacts']:.0f} | {r} | "
+                     f"{seconds(row['seconds'])} | {sci(row.get('natural_map'))} | {row.get('sticking', 0):.0f} | "
+                     f"{row.get('sliding', 0):.0f} | {'yes' if row['exact'] >= 1 else 'no'} | {ratio} |")
+    return "\n".join(lines)
+
+
+def friction_fits(res):
+    """Fitted exponent of time against contacts per (resolver, family, μ) over at least 3 rows."""
+    groups = {}
+    for *_, family, mu, scene, r, row in friction_rows(res):
+        groups.setdefault((r, family, mu), []).append((row["contacts"], row["seconds"]))
+    lines = ["| Resolver | Family | μ | Rows | k |", "|---|---|---:|---:|---:|"]
+    for (r, family, mu), pts in groups.items():
+        k = fit_exponent(pts)
+        if k is not None:
+            lines.append(f"| {LABELS[r]} | {family} | {mu} | {len(pts)} | {k:.2f} |")
+    return "\n".join(lines)
 
 
 def scaling_table(fits):
@@ -332,7 +371,7 @@ def charts(res, out_dir):
         ringed = False
         for r in RESOLVERS:
             pts = sorted((row["contacts"], row["seconds"], row["exact"] >= 1) for s, row in res.get(r, {}).items()
-                         if "error" not in row and s.startswith(family) and not s.endswith("_e1"))
+                         if "error" not in row and s.startswith(family) and not s.endswith("_e1") and "_mu" not in s)
             if not pts:
                 continue
             ax.plot([p[0] for p in pts], [p[1] for p in pts], marker=markers[r], label=LABELS[r])
@@ -394,6 +433,16 @@ def main():
            scaling_table(fits), "",
            "## Every row of the `resolve` family", "",
            full_table(res), ""]
+    if friction_rows(res):
+        out += ["## With Coulomb friction (`resolve` rows `…_mu<μ>`)", "",
+                "The same scenes with friction coefficient μ on every contact (`benchmarks/resolve.cpp`). "
+                "*Natural map* is fclib's error of the impulses (‖r − P_K(r − (u + μ‖u_t‖ n))‖ over the "
+                "contacts, from the velocities after the solve); *exact* means natural map ≤ 1e-9 and no "
+                "approach left; *sticking* and *sliding* count the contacts with an impulse and no slip after "
+                "it, and with slip. The last column divides by the frictionless exact resolve of the same "
+                "scene.", "", friction_table(res), "",
+                "Fitted exponent of time against contacts (all rows, exact or not):", "",
+                friction_fits(res), ""]
     cold = load(os.path.join(data_dir, "resolve_cold.json"))
     if cold:
         out += ["## A new contact pattern (`resolve_cold` rows)", "",
@@ -401,7 +450,7 @@ def main():
                 "one of 40 start points: the same problem, rows in a new order, more patterns than ledas caches "
                 "analyses of), against the same pattern solved again right after (the warm solve of the rows "
                 "above). The cold solve pays the symbolic analysis (AMD ordering, elimination tree, row patterns "
-                "of L); with friction the frictional solver, which keeps no analysis, dominates both. "
+                "of L); with friction the interior point's and Newton's shared analysis of W. "
                 "`benchmarks/resolve.cpp`, `resolve_cold`.", "",
                 f"Machine: {machine(cold['context'])}.", "",
                 cold_table(cold["rows"]), ""]
