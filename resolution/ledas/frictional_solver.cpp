@@ -80,7 +80,7 @@ struct FrictionalWorkspace::Newton {
   // the last one's pattern allocates nothing either (where no contact slides above `dense_limit`).
   ConeQpWorkspace cone_qp;
   std::vector<Block> stage_blocks;
-  Vector stage_diagonal, stage_best, cold_best, polished, velocity, next;
+  Vector stage_diagonal, stage_best, cold_best, polished, velocity, next, warm_answer;
   FrictionalProblem relaxed, sub, exact;
   SparseMatrix shifted;
 };
@@ -263,6 +263,17 @@ void assemble_jacobian(const std::vector<Block>& blocks, const std::vector<Linea
 bool symmetric_pieces(const std::vector<Linearization>& lin) {
   return std::all_of(lin.begin(), lin.end(),
                      [](const Linearization& l) { return l.piece == Piece::open || l.piece == Piece::active; });
+}
+
+// Whether a pressed contact slips at r (a block on the slide piece of the Alart–Curnier function), with
+// Newton's buffers as scratch.
+bool slips(const FrictionalProblem& problem, const std::vector<Block>& blocks, const Vector& r,
+           FrictionalWorkspace::Newton& buffers) {
+  buffers.u.noalias() = *problem.w * r;
+  buffers.u += problem.q;
+  buffers.f.resize(r.size());
+  evaluate(blocks, r, buffers.u, buffers.f, buffers.lin);
+  return std::any_of(buffers.lin.begin(), buffers.lin.end(), [](const Linearization& l) { return l.piece == Piece::slide; });
 }
 
 // The Newton direction when symmetric_pieces(lin): on the open rows O, d_O = −F_O; on the active rows A,
@@ -596,10 +607,13 @@ void FrictionalSolver::solve(const FrictionalProblem& problem, FrictionalStats& 
   const bool warm = problem.start != nullptr && problem.start->size() == m && problem.start->allFinite();
   if (!(warm && problem.start == &r)) r.setZero(m);  // r may be the warm start itself
   double residual = 0.0;
+  bool warm_slips = false;  // the warm start's Newton steps reached a slipping answer, kept in warm_answer
   if (warm && !problem.convex) {
     // 0. The warm start (e.g. the last step's impulses): a resting body's usually solve the problem as
-    //    they are; otherwise a few Newton steps from them, and if those do not reach the tolerance, the
-    //    cold path below.
+    //    they are; otherwise a few Newton steps from them. If those do not reach the tolerance, more
+    //    Newton steps; a sticking answer they reach is taken, a slipping one only if the relaxation
+    //    below shows that no static equilibrium exists (Newton from a warm start can find a Coulomb
+    //    solution that slips where the bodies could stick). Else the cold path below.
     r = *problem.start;
     residual = natural_map_residual(problem, r);
     if (residual > problem.tolerance && settings_.warm_newton_iterations > 0) {
@@ -607,8 +621,16 @@ void FrictionalSolver::solve(const FrictionalProblem& problem, FrictionalStats& 
       buffers_->diagonal = problem.w->diagonal();
       make_blocks(problem, buffers_->diagonal, buffers_->blocks);
       residual = newton(problem, buffers_->blocks, r, settings_.warm_newton_iterations, stats);
+      if (residual > problem.tolerance && settings_.warm_checked_iterations > 0) {
+        steps_left_ = settings_.warm_checked_iterations;
+        residual = newton(problem, buffers_->blocks, r, settings_.warm_checked_iterations, stats);
+        if (residual <= problem.tolerance && slips(problem, buffers_->blocks, r, *buffers_)) {
+          warm_slips = true;
+          buffers_->warm_answer = r;
+        }
+      }
     }
-    if (residual <= problem.tolerance) {
+    if (residual <= problem.tolerance && !warm_slips) {
       ++stats.warm_started;
       stats.residual = std::max(stats.residual, residual);
       return;
@@ -630,6 +652,10 @@ void FrictionalSolver::solve(const FrictionalProblem& problem, FrictionalStats& 
     ++stats.relaxed;
     const double relaxed_residual = solve_stages(relaxed, r, false, stats);
     residual = natural_map_residual(problem, r);
+    if (residual > problem.tolerance && warm_slips) {  // no static equilibrium: the warm start's answer
+      r = buffers_->warm_answer;
+      residual = natural_map_residual(problem, r);
+    }
     // 2. Where a pressed contact slips, the relaxation separates it at μ‖u_t‖ instead. Newton on
     //    Coulomb's problem from its answer (fast near a solution), then Cadoux's fixed point: the
     //    relaxation again with q_n raised by s = μ‖u_t‖ of the last answer (a fixed point is a Coulomb

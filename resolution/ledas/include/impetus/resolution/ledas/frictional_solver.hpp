@@ -96,6 +96,9 @@ struct FrictionalSettings {
   std::uint64_t fixed_point_iterations = 1;     ///< Cadoux's fixed-point steps (relaxations) at most
   std::uint64_t polish_newton_iterations = 8;   ///< Newton steps on Coulomb's problem from each of them
   std::uint64_t warm_newton_iterations = 2;     ///< Newton steps from a warm start that does not solve at once
+  /// Newton steps more when those do not solve it: a sticking answer is taken, a slipping one only if
+  /// the convex relaxation has no static equilibrium (else the relaxation's answer is).
+  std::uint64_t warm_checked_iterations = 28;
   std::uint64_t refinement_steps = 3;           ///< Newton steps past the tolerance on a cold answer
   std::uint64_t hybrid_rounds = 40;      ///< rounds of proximal Newton then Gauss–Seidel sweeps, at most
   std::uint64_t sweeps_per_round = 20;   ///< projected Gauss–Seidel sweeps per round
