@@ -13,6 +13,7 @@
 #include <algorithm>
 #include <cstdint>
 #include <string>
+#include <vector>
 
 namespace impetus::reliability {
 namespace {
@@ -104,32 +105,27 @@ std::string test_name(const testing::TestParamInfo<SteadyScene>& info) {
 // systems of more than FrictionalSettings::dense_limit rows (96) where no contact slides are the symmetric
 // LDLᵀ on W's kept analysis, which does not allocate (the pyramid of 10 rows, 300 rows); where a contact
 // slides they are factorized by Eigen's SparseLU, which allocates (README.md).
-INSTANTIATE_TEST_SUITE_P(
-    Frictional, SteadyState,
-    testing::Values(
-        // A pyramid of 10 spheres at rest with μ = 0.7 (every contact sticks).
-        SteadyScene{"pyramid_4_mu0.7", kModules + "generators:\n  - pyramid: {rows: 4, radius: 0.5, friction: 0.7}\n"},
-        // The pyramid of 55 spheres at rest with μ = 0.7: 300 rows, above dense_limit; Newton's steps, where
-        // every contact sticks, are the symmetric LDLᵀ on W's kept analysis.
-        SteadyScene{"pyramid_10_mu0.7", kModules + "generators:\n  - pyramid: {rows: 10, radius: 0.5, friction: 0.7}\n"},
-        // Five unit boxes stacked on the ground with μ = 0.5: four contacts per face, more rows than
-        // degrees of freedom (a redundant contact set; the warm start needs Newton's polish).
-        SteadyScene{"stack_5_mu0.5", kModules + box_stack(5, 0.5)}),
-    test_name);
+std::vector<SteadyScene> frictional_scenes(const std::string& modules) {
+  return {
+      // A pyramid of 10 spheres at rest with μ = 0.7 (every contact sticks).
+      SteadyScene{"pyramid_4_mu0.7", modules + "generators:\n  - pyramid: {rows: 4, radius: 0.5, friction: 0.7}\n"},
+      // The pyramid of 55 spheres at rest with μ = 0.7: 300 rows, above dense_limit; Newton's steps, where
+      // every contact sticks, are the symmetric LDLᵀ on W's kept analysis.
+      SteadyScene{"pyramid_10_mu0.7", modules + "generators:\n  - pyramid: {rows: 10, radius: 0.5, friction: 0.7}\n"},
+      // Five unit boxes stacked on the ground with μ = 0.5: four contacts per face, more rows than
+      // degrees of freedom (a redundant contact set; the warm start needs Newton's polish).
+      SteadyScene{"stack_5_mu0.5", modules + box_stack(5, 0.5)}};
+}
 
-// Without warm starts every step's frictional solve is cold: the interior point on the convex relaxation,
-// then Newton's polish, in the island's buffers, with the LDLᵀ analyses kept while W's pattern holds.
-const std::string kCold =
-    "modules: {integrator: momentum, detector: fcl, resolver: {plugin: ledas, mode: complementary, warm_start: false}}\n";
+INSTANTIATE_TEST_SUITE_P(Frictional, SteadyState, testing::ValuesIn(frictional_scenes(kModules)), test_name);
 
+// Without warm starts every step's frictional solve is cold: the interior point on the convex relaxation
+// (its LDLᵀ, on the sparse path for the 300 rows of the larger pyramid), then Newton's polish (with W
+// shifted on the redundant stack), in the island's buffers, with the analyses kept while W's pattern holds.
 INSTANTIATE_TEST_SUITE_P(
     FrictionalCold, SteadyState,
-    testing::Values(
-        SteadyScene{"pyramid_4_mu0.7", kCold + "generators:\n  - pyramid: {rows: 4, radius: 0.5, friction: 0.7}\n"},
-        // 300 rows: the interior point's LDLᵀ and Newton's symmetric one on the sparse path.
-        SteadyScene{"pyramid_10_mu0.7", kCold + "generators:\n  - pyramid: {rows: 10, radius: 0.5, friction: 0.7}\n"},
-        // Redundant: the relaxation's answer, polished by Newton with W shifted.
-        SteadyScene{"stack_5_mu0.5", kCold + box_stack(5, 0.5)}),
+    testing::ValuesIn(frictional_scenes(
+        "modules: {integrator: momentum, detector: fcl, resolver: {plugin: ledas, mode: complementary, warm_start: false}}\n")),
     test_name);
 
 // The sequential resolver (mirtich) keeps its buffers too: the same resting pyramid, and the stack of
