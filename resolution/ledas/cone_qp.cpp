@@ -10,6 +10,7 @@
 #include "cone_qp.hpp"
 
 #include <algorithm>
+#include <cassert>
 #include <cmath>
 #include <limits>
 #include <vector>
@@ -138,7 +139,7 @@ void prepare_pattern(const SparseMatrix& w, ConeQpWorkspace& ws) {
         }
     return true;
   };
-  const bool same_w = ws.h.rows() == m && ws.outer.size() == static_cast<std::size_t>(m) + 1 &&
+  const bool same_w = w.isCompressed() && ws.h.rows() == m && ws.outer.size() == static_cast<std::size_t>(m) + 1 &&
                       std::equal(ws.outer.begin(), ws.outer.end(), w.outerIndexPtr()) &&
                       ws.inner.size() == static_cast<std::size_t>(w.nonZeros()) &&
                       std::equal(ws.inner.begin(), ws.inner.end(), w.innerIndexPtr());
@@ -156,8 +157,12 @@ void prepare_pattern(const SparseMatrix& w, ConeQpWorkspace& ws) {
     ws.from_w.clear();
     for (Eigen::Index col = 0; col < m; ++col)
       for (SparseMatrix::InnerIterator it(w, col); it; ++it) ws.from_w.push_back(position(it.row(), col));
-    ws.outer.assign(w.outerIndexPtr(), w.outerIndexPtr() + m + 1);
-    ws.inner.assign(w.innerIndexPtr(), w.innerIndexPtr() + w.nonZeros());
+    ws.outer.clear();  // the key: W's compressed pattern (an uncompressed W is laid out afresh every time)
+    ws.inner.clear();
+    if (w.isCompressed()) {
+      ws.outer.assign(w.outerIndexPtr(), w.outerIndexPtr() + m + 1);
+      ws.inner.assign(w.innerIndexPtr(), w.innerIndexPtr() + w.nonZeros());
+    }
     locate_blocks();
   }
   ws.every_row.assign(static_cast<std::size_t>(m), 1);
@@ -167,6 +172,7 @@ void prepare_pattern(const SparseMatrix& w, ConeQpWorkspace& ws) {
 
 void solve_cone_qp(const FrictionalProblem& problem, double target, std::uint64_t max_iterations,
                    ConeQpWorkspace& ws, MaskedLdlt& ldlt, Vector& result, ConeQpReport& report) {
+  assert(problem.convex && "the interior point solves the relaxation: its residual is the relaxation's");
   const SparseMatrix& w = *problem.w;
   const Eigen::Index m = problem.q.size();
   report = {};
@@ -217,7 +223,6 @@ void solve_cone_qp(const FrictionalProblem& problem, double target, std::uint64_
   best.setZero(m);
   double best_residual = std::numeric_limits<double>::infinity();
   double* const h = ws.h.valuePtr();
-  const double* const w_value = w.valuePtr();
 
   for (; report.iterations < max_iterations; ++report.iterations) {
     r = x.cwiseQuotient(d);
@@ -241,7 +246,7 @@ void solve_cone_qp(const FrictionalProblem& problem, double target, std::uint64_
     std::fill(h, h + ws.h.nonZeros(), 0.0);
     for (Eigen::Index col = 0, e = 0; col < m; ++col)
       for (SparseMatrix::InnerIterator it(w, col); it; ++it, ++e)
-        h[ws.from_w[static_cast<std::size_t>(e)]] = w_value[e] / (d(it.row()) * d(col));
+        h[ws.from_w[static_cast<std::size_t>(e)]] = it.value() / (d(it.row()) * d(col));
     bool numerical_end = false;
     std::size_t entry = 0;
     for (std::size_t n = 0; n < cones.size(); ++n) {
