@@ -89,8 +89,12 @@ def fit_exponent(points):
 
 
 def scene_order(scene):
-    m = re.match(r"(pyramid|line)_(\d+)(?:_e(\d))?", scene)
-    return (m.group(1) != "pyramid", int(m.group(2)), m.group(3) or "")
+    """Pyramids, then lines, then the other families (stacks, walls) by name; by size within a family."""
+    m = re.match(r"(pyramid|line|[a-z]+)_(\d+)(?:_e(\d))?", scene)
+    if not m:
+        return (2, scene, 0, "")
+    rank = {"pyramid": 0, "line": 1}.get(m.group(1), 2)
+    return (rank, m.group(1), int(m.group(2)), scene)
 
 
 def machine(context):
