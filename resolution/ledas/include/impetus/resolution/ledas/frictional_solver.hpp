@@ -12,7 +12,9 @@
 /// W and q come in, r comes out, so it is tested (and later fed fclib's problems) directly.
 ///
 /// Method (resolution/ledas/README.md, "Friction"), in stages:
-///  0. a warm start, if given: taken if it solves the problem, else polished by a few Newton steps;
+///  0. a warm start, if given: taken if it solves the problem, else polished by a few Newton steps, then
+///     by more whose answer is taken if it sticks, or if it slips and the relaxation (1) has no static
+///     equilibrium;
 ///  1. the convex relaxation (`convex`), solved by an interior-point method (cone_qp.hpp) and polished by
 ///     Newton on its natural map: a static equilibrium is its answer whenever one exists, and where its
 ///     answer has no pressed contact slipping it is Coulomb's answer;
