@@ -88,6 +88,11 @@ def fit_exponent(points):
     return sxy / sxx
 
 
+def frictional(scene):
+    """Whether a scene name is a frictional row (…_mu<μ>): those have their own section."""
+    return "_mu" in scene
+
+
 def scene_order(scene):
     """Pyramids, then lines, then the other families (stacks, walls) by name; by size within a family."""
     m = re.match(r"(pyramid|line|[a-z]+)_(\d+)(?:_e(\d))?", scene)
@@ -147,7 +152,7 @@ def paper_table(res):
 
 
 def full_table(res):
-    scenes = sorted({s for r in res.values() for s in r if "_mu" not in s}, key=scene_order)
+    scenes = sorted({s for r in res.values() for s in r if not frictional(s)}, key=scene_order)
     lines = ["| Scene | Bodies | Contacts | Resolver | Time (median) | Rounds / impulses | Pulling | "
              "Residual (m/s) | Complementarity | Exact | Not converged |",
              "|---|---:|---:|---|---:|---:|---:|---:|---:|:-:|:-:|"]
@@ -173,7 +178,7 @@ def scaling(res):
     for r, scenes in res.items():
         fam = {"pyramid": [], "line_e0": [], "line_e1": []}
         for scene, row in scenes.items():
-            if "error" in row or "_mu" in scene:  # the frictional rows have their own section
+            if "error" in row or frictional(scene):
                 continue
             key = "pyramid" if scene.startswith("pyramid") else ("line_e1" if scene.endswith("_e1") else "line_e0")
             fam[key].append((row["contacts"], row["seconds"]))
@@ -182,7 +187,8 @@ def scaling(res):
 
 
 def friction_rows(res):
-    """[(family, μ, n, resolver, scene, row)] for the frictional rows (scene names …_mu<μ>), ordered."""
+    """The frictional rows (scene names …_mu<μ>) as (sort keys…, family, μ, scene, resolver, row): pyramids
+    first, then by μ falling, size, resolver."""
     entries = []
     for r, scenes in res.items():
         for scene, row in scenes.items():
@@ -375,7 +381,7 @@ def charts(res, out_dir):
         ringed = False
         for r in RESOLVERS:
             pts = sorted((row["contacts"], row["seconds"], row["exact"] >= 1) for s, row in res.get(r, {}).items()
-                         if "error" not in row and s.startswith(family) and not s.endswith("_e1") and "_mu" not in s)
+                         if "error" not in row and s.startswith(family) and not s.endswith("_e1") and not frictional(s))
             if not pts:
                 continue
             ax.plot([p[0] for p in pts], [p[1] for p in pts], marker=markers[r], label=LABELS[r])

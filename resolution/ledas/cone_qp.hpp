@@ -43,7 +43,7 @@ struct ConeQpWorkspace {
   std::vector<Scaling> scaling;
   std::vector<Eigen::Vector3d> eta;
   // P + T² on the pattern of W with every cone's diagonal block; where W's entry e and cone n's entry
-  // (a, b) are stored in it (`from_w`, `block`: 9 per cone, row-major), for W's pattern `outer`, `inner`.
+  // (a, b) are stored in it (`from_w`, `block`: size² per cone, row-major), for W's pattern `outer`, `inner`.
   SparseMatrix h;
   std::vector<SparseIndex> from_w, block, outer, inner;
   std::vector<char> every_row;
