@@ -30,8 +30,11 @@ constexpr std::size_t kInsertionMoves = 4;
 // Up to this many bodies, every pair is tested (no grid).
 constexpr std::size_t kFewBodies = 32;
 // The pair search's tasks (collect()): this many cells of a level, or bodies against coarser levels.
-constexpr std::size_t kCellsPerTask = 2048;
-constexpr std::size_t kBodiesPerTask = 1024;
+// Small enough that a pile of a thousand bodies (one level of ~700 cells) gives a dozen tasks to share
+// among the threads (with 2,048 cells per task it gave one, and the search ran on one thread); a task
+// costs a binary search per direction to place its cursors.
+constexpr std::size_t kCellsPerTask = 64;
+constexpr std::size_t kBodiesPerTask = 128;
 // Cell coordinates are clamped to [−2²⁰, 2²⁰) (21 bits each, packed into one key). Clamping keeps
 // overlapping boxes' corners within one cell of each other, so boxes beyond cost more tests only
 // (200 km from the origin for 10 cm bodies).
