@@ -564,10 +564,10 @@ void FrictionalSolver::proximal_newton(const FrictionalProblem& problem, const s
   double residual = natural_map_residual(problem, r);
   SparseMatrix& shifted = buffers_->shifted;
   double shifted_by = -1.0;
+  // The subproblems are of the problem's kind (Coulomb's or the relaxation, `convex`) and judged by its
+  // residual: w, q and the tolerance are set per point, the rest copied (the vectors' storage reused).
   FrictionalProblem& sub = buffers_->sub;
-  sub.role = problem.role;
-  sub.mu = problem.mu;
-  sub.workspace = problem.workspace;
+  sub = problem;
   Vector& next = buffers_->next;
   for (std::uint64_t outer = 0; outer < settings_.proximal_iterations && residual > problem.tolerance && steps_left_ > 0;
        ++outer) {

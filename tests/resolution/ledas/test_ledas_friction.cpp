@@ -370,5 +370,45 @@ TEST(LedasFriction, SolvingIntoAVectorMatchesTheReturnedSolution) {
   EXPECT_NEAR(warm(2), 0.0, 1e-12);
 }
 
+
+// The proximal stage solves the problem it is given: on the relaxation, its subproblems are relaxations
+// too. The contact of the tests above doubled (two identical contacts, W = [I I; I I], q twice: one
+// redundant contact), relaxed, with no interior point and no Gauss–Seidel sweeps, so that only proximal
+// Newton steps can solve it. The pair's total impulse is the closed form above, r₁ + r₂ = (1.6, −0.8, 0),
+// and both contacts separate at u_n = 0.6, to 1e-12. (Until 2026-12-05 each subproblem was judged by
+// Coulomb's residual, which the relaxation's answer does not zero here: no subproblem was ever accepted.)
+TEST(LedasFriction, ProximalStageSolvesTheRelaxationOnRedundantContacts) {
+  Eigen::MatrixXd pair(6, 6);
+  pair << Eigen::Matrix3d::Identity(), Eigen::Matrix3d::Identity(), Eigen::Matrix3d::Identity(),
+      Eigen::Matrix3d::Identity();
+  const ledas::SparseMatrix w = pair.sparseView();
+  const ledas::SparseMatrix single = Eigen::MatrixXd::Identity(3, 3).sparseView();
+  const ledas::FrictionalProblem one = one_pushed_contact(single);
+  ledas::FrictionalProblem problem = one;
+  problem.w = &w;
+  problem.q = ledas::Vector(6);
+  problem.q << one.q, one.q;
+  problem.role.insert(problem.role.end(), one.role.begin(), one.role.end());
+  problem.mu.insert(problem.mu.end(), one.mu.begin(), one.mu.end());
+  problem.dofs = 3;  // fewer than the rows: the solver knows W is singular
+  problem.convex = true;
+  ledas::FrictionalSettings settings;
+  settings.interior_point_iterations = 0;
+  settings.polish_newton_iterations = 0;
+  settings.sweeps_per_round = 0;
+  ledas::FrictionalSolver solver(settings);
+  ledas::FrictionalStats stats;
+  const ledas::Vector r = solver.solve(problem, stats);
+  EXPECT_EQ(stats.interior_point_steps, 0u);
+  EXPECT_GT(stats.proximal_steps, 0u);
+  EXPECT_EQ(stats.non_converged, 0u);
+  const ledas::Vector total = r.head(3) + r.tail(3), u = w * r + problem.q;
+  EXPECT_NEAR(total(0), 1.6, 1e-12);
+  EXPECT_NEAR(total(1), -0.8, 1e-12);
+  EXPECT_NEAR(total(2), 0.0, 1e-12);
+  EXPECT_NEAR(u(0), 0.6, 1e-12);
+  EXPECT_NEAR(u(3), 0.6, 1e-12);
+}
+
 }  // namespace
 }  // namespace impetus
