@@ -4,13 +4,14 @@
 #include "impetus/resolution/ledas/frictional_solver.hpp"
 
 #include "cone_qp.hpp"
+#include "sparse_lu.hpp"
 #include "impetus/resolution/ledas/masked_ldlt.hpp"
 
 #include <Eigen/Eigenvalues>
 #include <Eigen/LU>
-#include <Eigen/SparseLU>
 
 #include <algorithm>
+#include <cassert>
 #include <cmath>
 #include <stdexcept>
 
@@ -63,13 +64,16 @@ struct FrictionalWorkspace::Newton {
   std::vector<Linearization> lin, lin_trial;
   Eigen::MatrixXd jacobian;  // the dense path's
   Eigen::PartialPivLU<Eigen::MatrixXd> lu;
-  // The sparse path's: the Jacobian's entries, the Jacobian on the pattern of W + I (every piece's
-  // entries lie in it: a contact's rows share W's pattern), and its LU, whose ordering and symbolic
-  // analysis are kept while W's pattern (`analysed_outer`, `analysed_inner`) does not change.
+  // The sparse path's: the Jacobian on a pattern every linearization's entries lie in (jacobian_pattern),
+  // and its LU (KLU), whose ordering and symbolic analysis are kept while W's pattern (`analysed_outer`,
+  // `analysed_inner`) and the blocks' sizes do not change; `check` holds J d + F of a refactorization.
   std::vector<Eigen::Triplet<double>> entries;
-  SparseMatrix sparse_jacobian;
-  Eigen::SparseLU<SparseMatrix, Eigen::COLAMDOrdering<int>> sparse_lu;
+  RowMajorMatrix sparse_jacobian;
+  std::vector<int> slot;  // assembly: a column's place in the current block's rows
+  SparseLu sparse_lu;
+  Vector check, row_sum;
   std::vector<SparseMatrix::StorageIndex> analysed_outer, analysed_inner;
+  std::vector<int> analysed_blocks;
   // The symmetric path's (no block slides): LDLᵀ of (W + shift I) on the active rows, W's analysis kept
   // while its pattern does not change (and shared with the interior point's P + T², whose pattern is W's);
   // the active rows and the right-hand side.
@@ -317,6 +321,23 @@ bool symmetric_direction(const std::vector<Block>& blocks, const std::vector<Lin
   return d.allFinite();
 }
 
+// The pattern of every Jacobian assemble_jacobian() can build on W's pattern, into `j` (by rows, values
+// zero): a row of a block takes W's column of every row of its block (add_w_row) and the block's own
+// 3 × 3 block, so the rows of a block share one pattern. Built once per pattern of W.
+void jacobian_pattern(const std::vector<Block>& blocks, const SparseMatrix& w,
+                      std::vector<Eigen::Triplet<double>>& entries, RowMajorMatrix& j) {
+  entries.clear();
+  for (const Block& b : blocks)
+    for (int a = 0; a < b.size; ++a)
+      for (int c = 0; c < b.size; ++c) {
+        entries.emplace_back(b.first + a, b.first + c, 0.0);
+        for (SparseMatrix::InnerIterator it(w, b.first + c); it; ++it) entries.emplace_back(b.first + a, it.row(), 0.0);
+      }
+  j.resize(w.rows(), w.cols());
+  j.setFromTriplets(entries.begin(), entries.end());
+  j.makeCompressed();
+}
+
 // The Newton direction: J d = −F, into d (the dense path in `buffers`, without allocating when the
 // size did not change; the symmetric path when no block slides). False if the system could not be
 // solved to finite values.
@@ -336,38 +357,71 @@ bool newton_direction(const std::vector<Block>& blocks, const std::vector<Linear
   } else if (w.isCompressed() && symmetric_pieces(lin)) {
     return symmetric_direction(blocks, lin, w, shift, f, buffers, d);
   } else {
-    // The Jacobian on the fixed pattern of W + I (explicit zeros where this linearization has none), so
-    // that one ordering and symbolic analysis serve every Newton step on problems with W's pattern.
-    std::vector<Eigen::Triplet<double>>& entries = buffers.entries;
-    entries.clear();
-    for (Eigen::Index c = 0; c < m; ++c) {
-      for (SparseMatrix::InnerIterator it(w, c); it; ++it) entries.emplace_back(it.row(), c, 0.0);
-      entries.emplace_back(c, c, 0.0);
-    }
-    assemble_jacobian(blocks, lin, w, shift,
-                      [&entries](Eigen::Index r, Eigen::Index c, double v) { entries.emplace_back(r, c, v); });
-    SparseMatrix& j = buffers.sparse_jacobian;
-    j.resize(m, m);
-    j.setFromTriplets(entries.begin(), entries.end());
-    auto& lu = buffers.sparse_lu;
+    RowMajorMatrix& j = buffers.sparse_jacobian;
+    SparseLu& lu = buffers.sparse_lu;
     const bool same_pattern =
         w.isCompressed() && buffers.analysed_outer.size() == static_cast<std::size_t>(m) + 1 &&
         std::equal(buffers.analysed_outer.begin(), buffers.analysed_outer.end(), w.outerIndexPtr()) &&
         buffers.analysed_inner.size() == static_cast<std::size_t>(w.nonZeros()) &&
-        std::equal(buffers.analysed_inner.begin(), buffers.analysed_inner.end(), w.innerIndexPtr());
+        std::equal(buffers.analysed_inner.begin(), buffers.analysed_inner.end(), w.innerIndexPtr()) &&
+        std::equal(blocks.begin(), blocks.end(), buffers.analysed_blocks.begin(), buffers.analysed_blocks.end(),
+                   [](const Block& b, int size) { return b.size == size; });
     if (!same_pattern) {
-      lu.analyzePattern(j);
+      jacobian_pattern(blocks, w, buffers.entries, j);
+      if (!lu.analyze(j)) return false;
       buffers.analysed_outer.assign(w.outerIndexPtr(), w.outerIndexPtr() + m + 1);
       buffers.analysed_inner.assign(w.innerIndexPtr(), w.innerIndexPtr() + w.nonZeros());
+      buffers.analysed_blocks.clear();
+      for (const Block& b : blocks) buffers.analysed_blocks.push_back(b.size);
     }
-    lu.factorize(j);
-    if (lu.info() != Eigen::Success) {
+    // The entries in place. assemble_jacobian() adds to the rows of one block after another, and a
+    // block's rows share their pattern: `slot` maps a column to its place in the current block's rows.
+    std::fill(j.valuePtr(), j.valuePtr() + j.nonZeros(), 0.0);
+    const SparseMatrix::StorageIndex* outer = j.outerIndexPtr();
+    const SparseMatrix::StorageIndex* inner = j.innerIndexPtr();
+    double* value = j.valuePtr();
+    std::vector<int>& slot = buffers.slot;
+    slot.assign(static_cast<std::size_t>(m), -1);
+    Eigen::Index block_first = 0, block_end = 0;
+    std::size_t next_block = 0;
+    assemble_jacobian(blocks, lin, w, shift, [&](Eigen::Index r, Eigen::Index c, double v) {
+      if (r >= block_end) {
+        while (r >= blocks[next_block].first + blocks[next_block].size) ++next_block;
+        block_first = blocks[next_block].first;
+        block_end = block_first + blocks[next_block].size;
+        for (auto p = outer[block_first]; p < outer[block_first + 1]; ++p)
+          slot[static_cast<std::size_t>(inner[p])] = static_cast<int>(p - outer[block_first]);
+      }
+      const int place = slot[static_cast<std::size_t>(c)];
+      assert(r >= block_first && place >= 0 && inner[outer[block_first] + place] == c &&
+             "an entry outside jacobian_pattern()");
+      value[outer[r] + place] += v;
+    });
+    // J d = −F as −(J⁻¹ F). The last pivot sequence first (no allocation); kept if the direction it
+    // gives solves J d = −F to a backward error of 1e-12, else a factorization with partial pivoting.
+    const auto direction = [&](bool reuse_pivots) {
+      if (!lu.factorize(j, reuse_pivots)) return false;
+      d = f;
+      if (!lu.solve(d)) return false;
+      d = -d;
+      return true;
+    };
+    bool solved = direction(true);
+    if (solved) {
+      Vector& check = buffers.check;
+      check.noalias() = j * d;
+      check += f;
+      Vector& row_sum = buffers.row_sum;  // ‖J‖∞
+      row_sum.setZero(m);
+      for (Eigen::Index row = 0; row < m; ++row)
+        for (auto p = outer[row]; p < outer[row + 1]; ++p) row_sum(row) += std::abs(value[p]);
+      solved = check.lpNorm<Eigen::Infinity>() <=
+               1e-12 * (row_sum.maxCoeff() * d.lpNorm<Eigen::Infinity>() + f.lpNorm<Eigen::Infinity>());
+    }
+    if (!solved && !direction(false)) {
       buffers.analysed_outer.clear();  // analysed afresh next time
       return false;
     }
-    d = lu.solve(f);
-    if (lu.info() != Eigen::Success) return false;
-    d = -d;
   }
   return d.allFinite();
 }

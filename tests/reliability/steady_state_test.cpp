@@ -104,7 +104,9 @@ std::string test_name(const testing::TestParamInfo<SteadyScene>& info) {
 // start, polished by Newton steps where it does not solve at once, in each island's buffers. Newton's
 // systems of more than FrictionalSettings::dense_limit rows (96) where no contact slides are the symmetric
 // LDLᵀ on W's kept analysis, which does not allocate (the pyramid of 10 rows, 300 rows); where a contact
-// slides they are factorized by Eigen's SparseLU, which allocates (README.md).
+// slides they are factorized by KLU, whose refactorization on the last pivot sequence does not allocate
+// either, but a factorization with pivoting does (a pattern's first, or when the refactorization's
+// direction fails its check; README.md), so sliding scenes are not among these.
 std::vector<SteadyScene> frictional_scenes(const std::string& modules) {
   return {
       // A pyramid of 10 spheres at rest with μ = 0.7 (every contact sticks).
