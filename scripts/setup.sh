@@ -7,8 +7,10 @@ packages=(
   libeigen3-dev libfcl-dev libccd-dev libassimp-dev libyaml-cpp-dev
   libgtest-dev libgmock-dev libbenchmark-dev
   libcli11-dev nlohmann-json3-dev
-  # frictional contact problems in fclib's HDF5 form (core/fclib; brings HDF5)
+  # frictional contact problems in fclib's HDF5 form (core/fclib; brings HDF5 and SuiteSparse)
   libfclib-dev
+  # KLU, the sparse LU of the frictional Newton's Jacobians (resolution/ledas/sparse_lu.hpp)
+  libsuitesparse-dev
   binutils python3
   # peers side by side (benchmarks/peers) and charts (scripts/charts.py)
   libbullet-dev libode-dev libmujoco-dev python3-matplotlib
