@@ -273,7 +273,7 @@ bool symmetric_pieces(const std::vector<Linearization>& lin) {
 // Newton's buffers as scratch.
 bool slips(const FrictionalProblem& problem, const std::vector<Block>& blocks, const Vector& r,
            FrictionalWorkspace::Newton& buffers) {
-  buffers.u.noalias() = *problem.w * r;
+  buffers.u.noalias() = problem.w->transpose() * r;  // = W r (symmetric), as a gather
   buffers.u += problem.q;
   buffers.f.resize(r.size());
   evaluate(blocks, r, buffers.u, buffers.f, buffers.lin);
@@ -509,7 +509,7 @@ namespace {
 
 // natural_map_residual with u = W r + q computed into `u`.
 double natural_map_residual_in(const FrictionalProblem& problem, const Vector& r, Vector& u) {
-  u.noalias() = *problem.w * r;
+  u.noalias() = problem.w->transpose() * r;  // = W r (symmetric), as a gather
   u += problem.q;
   double sum = 0.0;
   const auto m = r.size();
@@ -560,7 +560,7 @@ double FrictionalSolver::newton(const FrictionalProblem& problem, const std::vec
   std::vector<Linearization>&lin = buffers.lin, &lin_trial = buffers.lin_trial;
   best = r;
   double best_residual = natural_map_residual(problem, r);
-  u.noalias() = w * r;
+  u.noalias() = w.transpose() * r;  // = W r (symmetric), as a gather
   u += problem.q;
   f.resize(m);
   trial.resize(m);
@@ -580,7 +580,7 @@ double FrictionalSolver::newton(const FrictionalProblem& problem, const std::vec
     bool accepted = false;
     for (; step >= kShortestStep; step *= 0.5) {
       trial = r + step * d;
-      u_trial.noalias() = w * trial;
+      u_trial.noalias() = w.transpose() * trial;  // = W trial (symmetric), as a gather
       u_trial += problem.q;
       evaluate(blocks, trial, u_trial, f_trial, lin_trial);
       trial_merit = 0.5 * f_trial.squaredNorm();
@@ -733,7 +733,7 @@ void FrictionalSolver::solve(const FrictionalProblem& problem, FrictionalStats& 
         best = polished;
       }
       if (best_residual <= problem.tolerance) break;
-      u.noalias() = *problem.w * r;
+      u.noalias() = problem.w->transpose() * r;  // = W r (symmetric), as a gather
       u += problem.q;
       relaxed.q = problem.q;
       for (const Block& block : blocks)
