@@ -371,6 +371,61 @@ TEST(LedasFriction, SolvingIntoAVectorMatchesTheReturnedSolution) {
 }
 
 
+// A slipping answer Newton reaches from a warm start is taken after the loose interior-point check only
+// where no static equilibrium exists, and it is then what the full relaxation leads to as well:
+//  - the pushed contact above (its relaxation separates: no equilibrium), from (0.9, −0.4, 0.1): the
+//    check takes the answer, Coulomb's r = (1, −0.5, 0) to 1e-12, bit for bit the full path's;
+//  - the sphere cluster above, 20 random draws, each warm-started from its cold answer with the normal
+//    impulses halved and the tangential ones reversed: where the warm Newton steps reach a slipping
+//    answer although the relaxation finds a static equilibrium, the check declines and the relaxation's
+//    answer is taken, bit for bit the full path's, solving the problem to its tolerance.
+// One unchecked warm Newton step (the default 2 reach the pushed contact's answer before the check).
+TEST(LedasFriction, SlippingWarmAnswerIsTakenOnlyWhereNoStaticEquilibriumExists) {
+  ledas::FrictionalSettings settings;
+  settings.warm_newton_iterations = 1;
+  ledas::FrictionalSettings full_settings = settings;
+  full_settings.slip_check = false;
+  {
+    const ledas::SparseMatrix w = Eigen::MatrixXd::Identity(3, 3).sparseView();
+    ledas::FrictionalProblem problem = one_pushed_contact(w);
+    ledas::Vector start(3);
+    start << 0.9, -0.4, 0.1;
+    problem.start = &start;
+    ledas::FrictionalSolver checked(settings), full(full_settings);
+    ledas::FrictionalStats checked_stats, full_stats;
+    const ledas::Vector r = checked.solve(problem, checked_stats);
+    EXPECT_EQ(r, full.solve(problem, full_stats));
+    EXPECT_EQ(checked_stats.slips_taken, 1u);
+    EXPECT_EQ(checked_stats.non_converged, 0u);
+    EXPECT_NEAR(r(0), 1.0, 1e-12);
+    EXPECT_NEAR(r(1), -0.5, 1e-12);
+    EXPECT_NEAR(r(2), 0.0, 1e-12);
+  }
+  std::mt19937_64 random(5);
+  SphereCluster cluster;
+  std::uint64_t declined = 0;
+  for (int trial = 0; trial < 20; ++trial) {
+    cluster.draw_velocities(random);
+    ledas::SparseMatrix w;
+    std::vector<resolution::ImpulseRow> rows;
+    ledas::FrictionalProblem problem = cluster.problem(std::vector<double>(SphereCluster::kContacts, 0.0), w, rows);
+    ledas::FrictionalSolver cold_solver;
+    ledas::FrictionalStats cold_stats;
+    ledas::Vector start = cold_solver.solve(problem, cold_stats);
+    for (Eigen::Index i = 0; i < start.size(); ++i) start(i) *= i % 3 == 0 ? 0.5 : -1.0;
+    problem.start = &start;
+    ledas::FrictionalSolver checked(settings), full(full_settings);
+    ledas::FrictionalStats checked_stats, full_stats;
+    const ledas::Vector r = checked.solve(problem, checked_stats);
+    EXPECT_EQ(r, full.solve(problem, full_stats)) << "draw " << trial;
+    EXPECT_EQ(checked_stats.non_converged, 0u) << "draw " << trial;
+    EXPECT_LE(ledas::natural_map_residual(problem, r), problem.tolerance) << "draw " << trial;
+    // The check ran (its interior point on top of the full path's) and declined.
+    if (checked_stats.slips_taken == 0 && checked_stats.interior_point_steps > full_stats.interior_point_steps) ++declined;
+  }
+  EXPECT_GE(declined, 10u);
+}
+
 // The proximal stage solves the problem it is given: on the relaxation, its subproblems are relaxations
 // too. The contact of the tests above doubled (two identical contacts, W = [I I; I I], q twice: one
 // redundant contact), relaxed, with no interior point and no Gauss–Seidel sweeps, so that only proximal

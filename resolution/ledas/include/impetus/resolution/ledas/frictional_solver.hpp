@@ -101,6 +101,10 @@ struct FrictionalSettings {
   /// Newton steps more when those do not solve it: a sticking answer is taken, a slipping one only if
   /// the convex relaxation has no static equilibrium (else the relaxation's answer is).
   std::uint64_t warm_checked_iterations = 28;
+  /// Where those reach a slipping answer: check first with an interior point to 1e4 × the tolerance
+  /// whether the relaxation's iterate slips too (Coulomb's residual above 1e3 × that target: no static
+  /// equilibrium exists), and if so take the answer without solving the relaxation to the tolerance.
+  bool slip_check = true;
   std::uint64_t refinement_steps = 3;           ///< Newton steps past the tolerance on a cold answer
   std::uint64_t hybrid_rounds = 40;      ///< rounds of proximal Newton then Gauss–Seidel sweeps, at most
   std::uint64_t sweeps_per_round = 20;   ///< projected Gauss–Seidel sweeps per round
@@ -117,6 +121,7 @@ struct FrictionalStats {
   std::uint64_t problems = 0;          ///< problems solved
   std::uint64_t warm_started = 0;      ///< problems solved from their warm start (`start`)
   std::uint64_t relaxed = 0;           ///< Coulomb problems started from their convex relaxation
+  std::uint64_t slips_taken = 0;       ///< slipping warm answers taken after the loose check (slip_check)
   std::uint64_t fixed_point_steps = 0; ///< Cadoux's fixed-point steps
   std::uint64_t newton_steps = 0;      ///< Newton steps (one factorization each)
   std::uint64_t interior_point_steps = 0;  ///< interior-point steps on relaxations (one factorization each)
