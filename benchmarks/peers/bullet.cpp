@@ -84,9 +84,9 @@ class BulletStep final : public PeerStep {
     for (auto& body : bodies_) world_->removeRigidBody(body.get());
   }
 
-  void reset() override {
+  void reset(std::span<const RigidBody> state, Carry carry) override {
     for (std::size_t i = 0; i < bodies_.size(); ++i) {
-      const RigidBody& b = scene_.bodies[i];
+      const RigidBody& b = state[i];
       if (b.fixed) continue;
       btRigidBody& body = *bodies_[i];
       const btTransform pose = transform(b);
@@ -98,8 +98,10 @@ class BulletStep final : public PeerStep {
       body.setInterpolationAngularVelocity(to_bt(b.angular_velocity));
       body.clearForces();
     }
-    // No warm start: the contact points (and their cached impulses) of the last step are dropped.
-    for (int m = 0; m < dispatcher_.getNumManifolds(); ++m) dispatcher_.getManifoldByIndexInternal(m)->clearManifold();
+    // Carry::drop, no warm start: the contact points (and their cached impulses) of the last step are
+    // dropped. Carry::keep: the next step refreshes them at the new poses and warm-starts from them.
+    if (carry == Carry::drop)
+      for (int m = 0; m < dispatcher_.getNumManifolds(); ++m) dispatcher_.getManifoldByIndexInternal(m)->clearManifold();
     solver_seconds_before_ = solver_seconds();
     fallbacks_before_ = mlcp_ ? mlcp_->getNumFallbacks() : 0;
   }
@@ -173,7 +175,7 @@ class BulletStep final : public PeerStep {
       world_->addRigidBody(body.get());
       bodies_.push_back(std::move(body));
     }
-    reset();
+    reset(scene_.bodies, Carry::drop);
   }
 
   const bench::PreparedScene& scene_;

@@ -19,8 +19,10 @@ class ImpetusStep final : public PeerStep {
   ImpetusStep(const bench::PreparedScene& scene, const std::string& resolver)
       : scene_(scene), bodies_(scene.bodies), contacts_(scene.contacts), resolver_(bench::make_resolver(resolver, /*velocity_only=*/true)) {}
 
-  void reset() override {
-    bench::restore_velocities(bodies_, scene_.bodies);
+  /// The resolver is made without warm starts (bench::make_resolver): nothing numeric carries over
+  /// whatever `carry` says; its symbolic analyses of the (one) contact pattern are kept, as in bench_resolve.
+  void reset(std::span<const RigidBody> state, Carry) override {
+    bench::restore_state(bodies_, state);
     contacts_ = scene_.contacts;
     counters_ = ResolverCounters{};
   }
@@ -83,13 +85,18 @@ class SolvedVelocities final : public Integrator {
 class ImpetusWholeStep final : public PeerStep {
  public:
   ImpetusWholeStep(const bench::PreparedScene& scene, const StepSettings& settings, const std::string& resolver)
-      : scene_(scene), pairs_(scene.contacts), world_(world_settings(settings)) {
+      : scene_(scene), resolver_(resolver), pairs_(scene.contacts), world_(world_settings(settings)) {
     bench::set_up_world(world_, scene.bodies);
     world_.set_integrator(solved_);
     world_.set_resolver(bench::make_resolver(resolver, /*velocity_only=*/false));
   }
 
-  void reset() override { bench::restore_state(world_.bodies(), scene_.bodies); }
+  /// Carry::drop: a new resolver, so no warm start and no symbolic analysis survives (the first step of a
+  /// new world).
+  void reset(std::span<const RigidBody> state, Carry carry) override {
+    bench::restore_state(world_.bodies(), state);
+    if (carry == Carry::drop) world_.set_resolver(bench::make_resolver(resolver_, /*velocity_only=*/false));
+  }
   void step() override { last_ = world_.step(); }
 
   StepResult result() override {
@@ -115,6 +122,7 @@ class ImpetusWholeStep final : public PeerStep {
     return w;
   }
   const bench::PreparedScene& scene_;
+  std::string resolver_;
   PairIndex pairs_;
   std::shared_ptr<SolvedVelocities> solved_ = std::make_shared<SolvedVelocities>();
   World world_;

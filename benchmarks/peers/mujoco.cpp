@@ -4,7 +4,8 @@
 // geom condim = 1 (frictionless; with friction, the "_mu" scenes: condim 3, friction
 // "μ 0 0" — sliding only — and elliptic cones, or pyramidal ones in the `_pyramidal` rows), Euler
 // integrator, dt, gravity as set; solver PGS, CG or
-// Newton with iterations 100 and tolerance 1e-10. One mj_step from mj_resetData (no warm start).
+// Newton with iterations 100 and tolerance 1e-10. One mj_step from mj_resetData (no warm start), or on
+// a dynamic scene from the state a step after an untimed one (qacc_warmstart kept).
 //
 // MuJoCo's contacts are soft (DESIGN of MuJoCo, "solver parameters"): the solve gives J a = d·a_ref with
 // impedance d < 1 and a_ref = −b v − k r, not the hard v_n⁺ = 0. Two settings:
@@ -94,7 +95,7 @@ class MujocoStep final : public PeerStep {
     model_->opt.iterations = config.iterations;
     model_->opt.tolerance = config.tolerance;
     data_ = mj_makeData(model_);
-    reset();
+    reset(scene_.bodies, Carry::drop);
   }
 
   ~MujocoStep() override {
@@ -102,12 +103,16 @@ class MujocoStep final : public PeerStep {
     mj_deleteModel(model_);
   }
 
-  void reset() override {
-    mj_resetData(model_, data_);  // qpos = the bodies' initial poses, warm start cleared
+  void reset(std::span<const RigidBody> state, Carry carry) override {
+    if (carry == Carry::drop) mj_resetData(model_, data_);  // the warm start (qacc_warmstart) cleared
     std::size_t k = 0;
-    for (const RigidBody& b : scene_.bodies) {
+    for (const RigidBody& b : state) {
       if (b.fixed) continue;
-      // Free joint: linear velocity in the world frame, angular velocity in the body frame.
+      // Free joint: position and orientation (w, x, y, z); linear velocity in the world frame, angular
+      // velocity in the body frame.
+      const Quat q = b.orientation();
+      const mjtNum pose[7] = {b.position.x(), b.position.y(), b.position.z(), q.w(), q.x(), q.y(), q.z()};
+      std::copy(pose, pose + 7, data_->qpos + 7 * k);
       const Vec3 local = b.rotation.transpose() * b.angular_velocity;
       for (int a = 0; a < 3; ++a) {
         data_->qvel[6 * k + a] = b.velocity[a];
@@ -115,6 +120,8 @@ class MujocoStep final : public PeerStep {
       }
       ++k;
     }
+    solver_seconds_ = 0.0;
+    steps_ = 0;
   }
 
   void step() override {

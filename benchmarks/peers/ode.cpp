@@ -53,12 +53,13 @@ class OdeStep final : public PeerStep {
     dWorldDestroy(world_);  // destroys its bodies
   }
 
-  void reset() override {
+  /// ODE keeps nothing from step to step (its contact joints are made anew each step): `carry` is moot.
+  void reset(std::span<const RigidBody> state, Carry) override {
     dJointGroupEmpty(joints_);
     feedback_.clear();
     contact_pairs_.clear();
     for (std::size_t i = 0; i < bodies_.size(); ++i) {
-      const RigidBody& b = scene_.bodies[i];
+      const RigidBody& b = state[i];
       if (!bodies_[i]) continue;
       dBodySetPosition(bodies_[i], b.position.x(), b.position.y(), b.position.z());
       const Quat q = b.orientation();
@@ -70,6 +71,8 @@ class OdeStep final : public PeerStep {
       dBodySetTorque(bodies_[i], 0, 0, 0);
     }
     ode_messages() = 0;
+    solver_seconds_ = 0.0;
+    steps_ = 0;
   }
 
   void step() override {
@@ -154,7 +157,7 @@ class OdeStep final : public PeerStep {
       dGeomSetData(geom, reinterpret_cast<void*>(static_cast<std::uintptr_t>(i)));
       bodies_.push_back(body);
     }
-    reset();
+    reset(scene_.bodies, Carry::drop);
   }
 
   const bench::PreparedScene& scene_;

@@ -11,6 +11,7 @@
 #include <functional>
 #include <limits>
 #include <memory>
+#include <span>
 #include <stdexcept>
 #include <string>
 #include <unordered_map>
@@ -45,16 +46,23 @@ struct StepResult {
   std::size_t extra = 0;                ///< engine points on a pair the Impetus detector has no contact for
   double iterations = 0;                ///< solver iterations (setting, or what the engine reports; 0 = direct)
   double failures = 0;                  ///< the exact solver gave up (Bullet MLCP fallback, ODE LCP error messages)
-  double solver_seconds = kNaN;         ///< the engine's solver alone, if it can be timed separately
+  double solver_seconds = kNaN;         ///< the engine's solver alone in the last step, if it can be timed separately
 };
 
+/// What an engine keeps across reset(): `drop` forgets everything it learnt in earlier steps (contact
+/// caches, warm-start impulses, Impetus's symbolic analyses), as a new world would; `keep` keeps it, as a
+/// running simulation does from one step to the next.
+enum class Carry { drop, keep };
+
 /// One method of one engine, configured on one scene. The benchmark calls reset() untimed, step() timed,
-/// and result() once at the end.
+/// and result() once at the end; on a dynamic scene, each timed step follows an untimed one from the
+/// state a step earlier (main.cpp, run()).
 class PeerStep {
  public:
   virtual ~PeerStep() = default;
-  /// Back to the scene's initial state (positions, velocities; no warm start, no cached impulses).
-  virtual void reset() = 0;
+  /// Puts the bodies in `state` (positions and velocities, the Impetus bodies' order: the scene's own
+  /// bodies or a state of them a step earlier), keeping or dropping what the engine learnt (Carry).
+  virtual void reset(std::span<const RigidBody> state, Carry carry) = 0;
   /// One engine step (contact generation + solve + integration), or the resolver alone for Impetus.
   virtual void step() = 0;
   /// The state after the last step().
