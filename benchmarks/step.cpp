@@ -128,41 +128,47 @@ void step(benchmark::State& state, const std::string& resolver_name, Scene scene
   }
 }
 
-// The dynamic scenes (support/bench_dynamic.hpp). Every iteration restores the scene's snapshot (untimed)
-// and times kDynamicSteps whole steps from it, so the contact pattern changes from step to step as in a
-// running simulation; the resolver keeps what it learnt in the previous iteration, as it would from the
-// previous step (an untimed first pass from the snapshot fills it, so that no timed iteration pays for a
-// start from nothing: the frictional pyramid's first solve is an interior-point solve of seconds, its
-// later ones a Newton step from the warm start). Counters are per step: step_ms and the stages,
+// The dynamic scenes (support/bench_dynamic.hpp). Every iteration starts as a running simulation would
+// be found at the snapshot: a new resolver (no warm start, no cached analysis), one untimed step from the
+// state a step before the snapshot, then the bodies put at the snapshot; it times kDynamicSteps whole
+// steps from there, so the contact pattern changes from step to step and every warm start comes from the
+// previous step, never from a timed step's own answer in an earlier iteration (bench_peers times its
+// dynamic rows the same way, one step). Counters are per step: step_ms and the stages,
 // contacts, islands, rounds; residual, natural_map and penetration (deepest contact a detection found)
 // are the largest over the steps, and energy_change the kinetic energy the resolve stage changed per
-// step (J).
+// step (J). With friction, ledas's rows also count its frictional stages per step (friction_problems,
+// warm_solved, slips_taken, relaxed, newton_steps, interior_point_steps, proximal_steps,
+// friction_non_converged: ledas::FrictionalStats).
 constexpr int kDynamicSteps = 5;
 
-const std::vector<RigidBody>& snapshot(const std::string& family, int n, double mu) {
-  static std::map<std::string, std::vector<RigidBody>> cache;
+const bench::DynamicStates& snapshot(const std::string& family, int n, double mu) {
+  static std::map<std::string, bench::DynamicStates> cache;
   const std::string key = family + "_" + std::to_string(n) + "_" + std::to_string(mu);
   auto it = cache.find(key);
-  if (it == cache.end()) it = cache.emplace(key, bench::dynamic_snapshot(bench::dynamic_scene(family, n, mu))).first;
+  if (it == cache.end()) it = cache.emplace(key, bench::dynamic_states(bench::dynamic_scene(family, n, mu))).first;
   return it->second;
 }
 
 void dynamic_step(benchmark::State& state, const std::string& resolver_name, const std::string& family, int n,
                   double mu, std::uint32_t threads) {
-  const std::vector<RigidBody>& start = snapshot(family, n, mu);
+  const bench::DynamicStates& states = snapshot(family, n, mu);
+  const std::vector<RigidBody>& start = states.at;
   World world;
   bench::set_up_world(world, start);
-  world.set_resolver(bench::make_resolver(resolver_name, /*velocity_only=*/false));
+  ledas::FrictionalStats friction;
   world.set_threads(threads);
   StepProfile sum;
   double contacts = 0, islands = 0, rounds = 0, energy = 0, residual = 0, natural_map = 0, penetration = 0;
-  for (int i = 0; i < kDynamicSteps; ++i)
+  for (auto _ : state) {
+    state.PauseTiming();
+    std::shared_ptr<CollisionResolver> resolver = bench::make_resolver(resolver_name, /*velocity_only=*/false);
+    const auto* ledas = dynamic_cast<const LedasResolver*>(resolver.get());  // its frictional stages, counted
+    world.set_resolver(std::move(resolver));
+    bench::restore_state(world.bodies(), states.before);
     if (const StepStatus& s = world.step(); !s.ok) {
       state.SkipWithError(s.message.c_str());
       return;
     }
-  for (auto _ : state) {
-    state.PauseTiming();
     bench::restore_state(world.bodies(), start);
     state.ResumeTiming();
     for (int i = 0; i < kDynamicSteps; ++i) {
@@ -184,6 +190,7 @@ void dynamic_step(benchmark::State& state, const std::string& resolver_name, con
       residual = std::max(residual, s.resolver.residual);
       natural_map = std::max(natural_map, s.resolver.natural_map_residual);
       for (const Contact& c : world.contacts()) penetration = std::max(penetration, c.depth);
+      if (ledas != nullptr) ledas::add(friction, ledas->last_stats().friction);
       state.ResumeTiming();
     }
   }
@@ -199,7 +206,20 @@ void dynamic_step(benchmark::State& state, const std::string& resolver_name, con
   state.counters["energy_change"] = per_step(energy);
   state.counters["residual"] = residual;
   state.counters["penetration"] = penetration;
-  if (resolver_name.starts_with("ledas") && mu > 0) state.counters["natural_map"] = natural_map;
+  if (resolver_name.starts_with("ledas") && mu > 0) {
+    state.counters["natural_map"] = natural_map;
+    // Where the frictional solver's time goes, per step: its island problems, those their warm start
+    // solved (with at most warm_newton + warm_checked Newton steps), the slipping warm answers taken
+    // after the loose check, those solved cold (from the convex relaxation), and its factorizations.
+    state.counters["friction_problems"] = per_step(static_cast<double>(friction.problems));
+    state.counters["warm_solved"] = per_step(static_cast<double>(friction.warm_started));
+    state.counters["slips_taken"] = per_step(static_cast<double>(friction.slips_taken));
+    state.counters["relaxed"] = per_step(static_cast<double>(friction.relaxed));
+    state.counters["newton_steps"] = per_step(static_cast<double>(friction.newton_steps));
+    state.counters["interior_point_steps"] = per_step(static_cast<double>(friction.interior_point_steps));
+    state.counters["proximal_steps"] = per_step(static_cast<double>(friction.proximal_steps));
+    state.counters["friction_non_converged"] = per_step(static_cast<double>(friction.non_converged));
+  }
 }
 
 void register_dynamic(long max_bodies) {

@@ -475,15 +475,19 @@ def main():
         out += ["## Dynamic scenes (`step` family, rows `…_t1`, `…_t2`)", "",
                 "Scenes whose contact pattern changes almost every step (`benchmarks/support/bench_dynamic.hpp`): "
                 "a pile of mixed spheres, boxes and capsules poured into a bin, a heap of spheres settling on open "
-                "ground, a brick wall hit by a heavy ball. Each iteration restores the scene's snapshot and times "
-                "5 whole steps from it; the figures are per step, wall time, with 1 and 2 threads "
+                "ground, a brick wall hit by a heavy ball, the pyramid of 100 rows at rest. Each iteration gives "
+                "the world a new resolver, steps it once untimed from the state a step before the scene's "
+                "snapshot, puts it at the snapshot and times 5 whole steps from there, so every warm start and "
+                "cached analysis comes from an earlier step of the same run, as in a simulation (never from an "
+                "earlier iteration's timed steps); the figures are per step, wall time, with 1 and 2 threads "
                 "(`World::set_threads`). *Residual* and *natural map* are the resolver's own, the largest over "
                 "the steps; *deepest* the deepest contact a detection found.", "",
                 dynamic_table(dynamic["rows"]), ""]
     if dynamic_peers:
         out += ["### The dynamic scenes in every engine", "",
                 "One whole step under gravity from each scene's snapshot (the heaps, the pile of 1,000 mixed "
-                "primitives in its bin, the wall of 200 bricks being knocked over), each engine with its own "
+                "primitives in its bin, the wall of 200 bricks being knocked over, the pyramid of 100 rows at "
+                "rest), each engine with its own "
                 "detection (Impetus on one thread, as the others), judged at the contacts Impetus finds touching "
                 "in the snapshot: *residual* is the largest approach velocity there, *complementarity* the "
                 "largest impulse times separation over the pairs of bodies (a box's face is judged as one pair, "
@@ -491,9 +495,10 @@ def main():
                 "disagree on the geometry (a capsule on a box's edge), the judge is Impetus's detector. With "
                 "μ = 0.5 (`_mu0.5`), each engine's own friction law; *natural map* is fclib's error of the "
                 "impulses each engine reports, measured on the heap (one point per pair) and not on the pile "
-                "(its face contacts have each engine's own points). An "
-                "engine's step includes rebuilding its contact cache after the benchmark's reset of every body, "
-                "which a running simulation does not pay: *solver alone* is the fairer comparison of the solves.", "",
+                "(its face contacts have each engine's own points). Each timed step follows an untimed one "
+                "from the state a step before the snapshot, every engine emptied of its caches first, so each "
+                "warm-starts from a previous step as in a running simulation (`benchmarks/peers/README.md`); "
+                "*solver alone* is the engine's solve in that step.", "",
                 dynamic_peers_table(dynamic_peers["rows"]), ""]
     if detect:
         out += ["## Detection alone (`detect` family)", "", detect_table(detect["rows"]), ""]
