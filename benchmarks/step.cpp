@@ -137,7 +137,7 @@ void step(benchmark::State& state, const std::string& resolver_name, Scene scene
 // contacts, islands, rounds; residual, natural_map and penetration (deepest contact a detection found)
 // are the largest over the steps, and energy_change the kinetic energy the resolve stage changed per
 // step (J). With friction, ledas's rows also count its frictional stages per step (friction_problems,
-// warm_solved, slips_taken, relaxed, newton_steps, interior_point_steps, proximal_steps,
+// warm_solved, slips_taken, releases, relaxed, newton_steps, interior_point_steps, proximal_steps,
 // friction_non_converged: ledas::FrictionalStats).
 constexpr int kDynamicSteps = 5;
 
@@ -214,6 +214,7 @@ void dynamic_step(benchmark::State& state, const std::string& resolver_name, con
     state.counters["friction_problems"] = per_step(static_cast<double>(friction.problems));
     state.counters["warm_solved"] = per_step(static_cast<double>(friction.warm_started));
     state.counters["slips_taken"] = per_step(static_cast<double>(friction.slips_taken));
+    state.counters["releases"] = per_step(static_cast<double>(friction.releases));
     state.counters["relaxed"] = per_step(static_cast<double>(friction.relaxed));
     state.counters["newton_steps"] = per_step(static_cast<double>(friction.newton_steps));
     state.counters["interior_point_steps"] = per_step(static_cast<double>(friction.interior_point_steps));

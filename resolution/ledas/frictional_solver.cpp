@@ -485,6 +485,7 @@ void add(FrictionalStats& into, const FrictionalStats& part) {
   into.warm_started += part.warm_started;
   into.relaxed += part.relaxed;
   into.slips_taken += part.slips_taken;
+  into.releases += part.releases;
   into.fixed_point_steps += part.fixed_point_steps;
   into.newton_steps += part.newton_steps;
   into.interior_point_steps += part.interior_point_steps;
@@ -785,9 +786,62 @@ void FrictionalSolver::solve(const FrictionalProblem& problem, FrictionalStats& 
       steps_left_ = settings_.refinement_steps;
       residual = newton(exact, blocks, r, settings_.refinement_steps, stats);
     }
+    // 5. Still not solved, on a small problem: one pressed contact released (release_one_contact).
+    if (residual > problem.tolerance && blocks.size() <= settings_.release_max_contacts)
+      residual = release_one_contact(problem, blocks, r, stats);
   }
   if (residual > problem.tolerance) ++stats.non_converged;
   stats.residual = std::max(stats.residual, residual);
+}
+
+// Newton steps per release try at most (release_one_contact): a contact rightly released leaves a
+// problem Newton solves in a few steps from the iterate; a wrong one is abandoned quickly.
+constexpr std::uint64_t kReleaseNewtonSteps = 30;
+
+// From the best iterate r of a problem the stages left unsolved: the pressed contacts that separate
+// there (r_n > 0 but u_n > 0), fastest first, each in turn forced open (its q_n raised by 10 (‖q‖ + 1),
+// so that it separates whatever the others do) and the problem solved again from r with that contact's
+// impulse zeroed, by a solver of the same settings without this stage. A try is kept if it solves the
+// problem itself (the released contact's u_n ≥ 0 then, its r = 0). Returns r's residual. The tries run in
+// their own buffers (an allocation per try: small problems, after the stages have failed).
+double FrictionalSolver::release_one_contact(const FrictionalProblem& problem, const std::vector<Block>& blocks,
+                                             Vector& r, FrictionalStats& stats) {
+  const Vector u = problem.w->transpose() * r + problem.q;  // W r + q (W symmetric), as a gather
+  std::vector<std::pair<double, std::size_t>> candidates;
+  for (std::size_t k = 0; k < blocks.size(); ++k) {
+    const Block& b = blocks[k];
+    if (b.role == RowRole::normal && r(b.first) > 0.0 && u(b.first) > 0.0) candidates.emplace_back(-u(b.first), k);
+  }
+  std::sort(candidates.begin(), candidates.end());
+  if (candidates.size() > settings_.release_tries) candidates.resize(settings_.release_tries);
+  FrictionalSettings inner_settings = settings_;
+  inner_settings.release_max_contacts = 0;
+  inner_settings.max_newton_steps = kReleaseNewtonSteps;
+  const double raise = 10.0 * (problem.q.norm() + 1.0);
+  for (const auto& [speed, k] : candidates) {
+    const Block& b = blocks[k];
+    FrictionalWorkspace workspace;
+    FrictionalProblem released = problem;
+    released.q(b.first) += raise;
+    released.workspace = &workspace;
+    Vector start = r;
+    start.segment(b.first, b.size).setZero();
+    released.start = &start;
+    FrictionalSolver inner(inner_settings);
+    FrictionalStats inner_stats;
+    Vector answer;
+    inner.solve(released, inner_stats, answer);
+    inner_stats.problems = 0;  // one problem, counted by the caller
+    inner_stats.warm_started = inner_stats.non_converged = 0;
+    inner_stats.residual = 0.0;
+    add(stats, inner_stats);
+    if (const double residual = natural_map_residual(problem, answer); residual <= problem.tolerance) {
+      ++stats.releases;
+      r = answer;
+      return residual;
+    }
+  }
+  return natural_map_residual(problem, r);
 }
 
 // The stages (file comment) on `problem` from r, which they overwrite with the best iterate met; returns

@@ -426,6 +426,67 @@ TEST(LedasFriction, SlippingWarmAnswerIsTakenOnlyWhereNoStaticEquilibriumExists)
   EXPECT_GE(declined, 10u);
 }
 
+// A problem the stages leave stalled, dumped from the frictional pile of bench_step (2026-12-05): one box
+// (6 degrees of freedom) on the ground at 4 contacts, μ = 0.5, two of them approaching at 1.57 m/s. Every
+// stage presses all four contacts and stalls at a natural-map residual of 1.9e-5; the solution leaves
+// the fourth open (projected Gauss–Seidel finds it after ~1,000 sweeps). With the release stage the
+// solver reaches fclib's natural map ≤ the tolerance by forcing that contact open: Coulomb's law holds
+// at every contact (the residual is zero exactly when it does), the released contact carries no impulse
+// and separates (u_n ≥ 0). Without the stage the same problem is counted unconverged.
+TEST(LedasFriction, ReleasingOneContactSolvesWhereEveryStageStalls) {
+  const double lower[] = {
+      1.8239385470855221, 0.5605172468188947, 0.59051337698547635, -0.24172044607345169, 0.14609289324644092,
+      1.5827665912785611, 0.22393979923631985, -0.15987778569173688, -0.5886458314870483, 1.8239388794830029,
+      0.56026092985282483, 0.72395059608550349, 0.8280558289293517, -0.1596214753162658, 1.3408009669735985,
+      -0.24118958447332636, -0.13046961044728159, 0.16932833128367986, -0.58917667942740204, -0.45043004667593084,
+      0.83247909140468956, 0.44102832581745283, 0.15938507371887883, 0.58966683652228113, -1.1589704227649302,
+      0.15912876340470855, 0.59019768433566167, 1.8273394761186468, 0.55936630756039563, 0.38248306556216949,
+      -0.91386699474302147, -0.1598341361987575, -0.23552065042887832, 0.3670089637226594, 0.15934278590358045,
+      1.3425308060360088, -0.24086146238775835, 0.046131592338302295, 1.0705014274205522, -0.58721047646423519,
+      0.36553543357674123, 0.40850410193513642, 0.5882286603777882, -0.45024911203322082, 0.83015720141581206,
+      -1.1589704220317485, -0.56100995879175219, 0.24274145110868481, 0.4410286574817518, -0.56075364176438158,
+      0.24221058938158635, 0.22734072753626494, -0.55985765785557218, 0.24187964630131165, 1.8273398070497642,
+      0.55910999059432576, 0.51592028466219664, -0.23190405906011108, -0.15957782582328636, 0.38132972045921637,
+      0.047048527494010256, 0.15908647558941014, 0.72452709004496141, -0.13084527079478206, -0.55960134082820145,
+      0.58993652584198131, -0.24033060078763299, -0.23043091135542002, -0.34293683257432822, -0.58774132440458904,
+      -0.91295044202854048, 1.0716548620561457, 0.58875950819116896, 0.83062684643245932, 0.16815987593039666,
+      0.24134878457421322, 0.14810731575933908, 1.5827515705608699,
+  };
+  const double q[] = {-1.5698639851772085, 0.26863832330346077, 0.19417066529508392, -1.5698821452072425, 0.26517984982081932, 0.20133870654283836, -0.0043893198394081567, 0.27463998747818952, 0.19546815186803573, -0.0043660217618699537, 0.27118151399554807, 0.20263619311579018};
+
+  Eigen::MatrixXd dense(12, 12);
+  for (int i = 0, k = 0; i < 12; ++i)
+    for (int j = 0; j <= i; ++j, ++k) dense(i, j) = dense(j, i) = lower[k];
+  const ledas::SparseMatrix w = dense.sparseView();
+  ledas::FrictionalProblem problem;
+  problem.w = &w;
+  problem.q = Eigen::Map<const ledas::Vector>(q, 12);
+  for (int c = 0; c < 4; ++c) {
+    problem.role.insert(problem.role.end(), {ledas::RowRole::normal, ledas::RowRole::tangent, ledas::RowRole::tangent});
+    problem.mu.insert(problem.mu.end(), {0.5, 0.0, 0.0});
+  }
+  problem.dofs = 6;
+  problem.tolerance = 1e-10 * problem.q.norm();
+  ledas::FrictionalSettings without;
+  without.release_max_contacts = 0;
+  ledas::FrictionalSolver stalled(without), solver;
+  ledas::FrictionalStats stalled_stats, stats;
+  const ledas::Vector stuck = stalled.solve(problem, stalled_stats);
+  EXPECT_EQ(stalled_stats.non_converged, 1u);
+  EXPECT_GT(ledas::natural_map_residual(problem, stuck), 1e-6);
+  const ledas::Vector r = solver.solve(problem, stats);
+  EXPECT_EQ(stats.non_converged, 0u);
+  EXPECT_EQ(stats.releases, 1u);
+  EXPECT_LE(ledas::natural_map_residual(problem, r), problem.tolerance);
+  const ledas::Vector u = w * r + problem.q;
+  EXPECT_EQ(r.segment(9, 3), ledas::Vector::Zero(3));
+  EXPECT_GE(u(9), -problem.tolerance);
+  for (int c = 0; c < 3; ++c) {  // the other three press and slide on the cone's surface
+    EXPECT_GT(r(3 * c), 0.0);
+    EXPECT_NEAR(r.segment(3 * c + 1, 2).norm(), 0.5 * r(3 * c), 1e-9);
+  }
+}
+
 // The proximal stage solves the problem it is given: on the relaxation, its subproblems are relaxations
 // too. The contact of the tests above doubled (two identical contacts, W = [I I; I I], q twice: one
 // redundant contact), relaxed, with no interior point and no Gauss–Seidel sweeps, so that only proximal

@@ -106,6 +106,13 @@ struct FrictionalSettings {
   /// equilibrium exists), and if so take the answer without solving the relaxation to the tolerance.
   bool slip_check = true;
   std::uint64_t refinement_steps = 3;           ///< Newton steps past the tolerance on a cold answer
+  /// A problem of at most this many contacts that the stages leave unsolved is tried with one contact
+  /// released: a pressed contact that separates at the best iterate (r_n > 0, u_n > 0) may belong open,
+  /// where Newton, having pressed every contact, stalls (a box's four points on the ground, one of them
+  /// leaving). Each try solves the problem with that contact forced open from the best iterate and is
+  /// kept if it solves the problem itself. 0: never.
+  std::size_t release_max_contacts = 8;
+  std::uint64_t release_tries = 3;  ///< contacts tried, those separating fastest first
   std::uint64_t hybrid_rounds = 40;      ///< rounds of proximal Newton then Gauss–Seidel sweeps, at most
   std::uint64_t sweeps_per_round = 20;   ///< projected Gauss–Seidel sweeps per round
   double regularization = 1e-10;         ///< W's diagonal shift in the Jacobian, × max W_ii
@@ -122,6 +129,7 @@ struct FrictionalStats {
   std::uint64_t warm_started = 0;      ///< problems solved from their warm start (`start`)
   std::uint64_t relaxed = 0;           ///< Coulomb problems started from their convex relaxation
   std::uint64_t slips_taken = 0;       ///< slipping warm answers taken after the loose check (slip_check)
+  std::uint64_t releases = 0;          ///< problems solved with one contact released (release_max_contacts)
   std::uint64_t fixed_point_steps = 0; ///< Cadoux's fixed-point steps
   std::uint64_t newton_steps = 0;      ///< Newton steps (one factorization each)
   std::uint64_t interior_point_steps = 0;  ///< interior-point steps on relaxations (one factorization each)
@@ -167,6 +175,8 @@ class FrictionalSolver {
                 std::uint64_t iterations, FrictionalStats& stats);
   void proximal_newton(const FrictionalProblem& problem, const std::vector<Block>& blocks, Vector& r,
                        FrictionalStats& stats);
+  double release_one_contact(const FrictionalProblem& problem, const std::vector<Block>& blocks, Vector& r,
+                             FrictionalStats& stats);
 
   FrictionalSettings settings_;
   std::uint64_t steps_left_ = 0;  // Newton steps left to the current solve (max_newton_steps)
