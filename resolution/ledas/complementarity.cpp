@@ -249,6 +249,7 @@ void ComplementaritySolver::solve(const ComplementarityProblem& problem, SolverS
     }
     return;
   }
+  if (suits_body_space(problem, settings_) && solve_in_body_space(problem, body_space_, stats, p)) return;
   Search search(problem, settings_, scale, *work_);
   search.loop.factor = checkout_masked(a, search.free_rows, stats);
   const std::uint64_t budget = work_budget(m, settings_);

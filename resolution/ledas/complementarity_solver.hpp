@@ -4,6 +4,7 @@
 /// factorization (complementarity.cpp), its exact refinement of a candidate free set, and the two
 /// minimum-norm pieces around it (complementarity_fallback.cpp).
 
+#include "body_space.hpp"
 #include "equality_solver.hpp"
 #include "impetus/resolution/ledas/island_solver.hpp"
 
@@ -61,6 +62,7 @@ class ComplementaritySolver {
   const SolverSettings& settings_;
   EqualitySolver& equalities_;
   std::vector<std::unique_ptr<MaskedLdlt>> masked_cache_;  // by pattern, least recently used first
+  BodySpaceWorkspace body_space_;  // the interior point's buffers
   Workspace own_;               // the buffers of a problem that brings none
   Workspace* work_ = &own_;     // the current solve's: the problem's workspace, or own_
 };

@@ -19,6 +19,11 @@ void LedasResolver::velocity_complementary(ledas::Island& island, std::span<Rigi
   problem.equality.assign(island.equality.begin(), island.equality.end());
   problem.start.assign(m, 0);
   problem.tolerance = settings_.tolerance;
+  problem.body_space = nullptr;
+  if (ledas::wants_body_space(island, m, solver_settings_)) {
+    ledas::assemble_body_space(rows_, island, {}, bodies, island.body_space);
+    problem.body_space = &island.body_space;
+  }
   const std::uint64_t failed_before = lane.stats.velocity.infeasible, unconverged_before = lane.stats.velocity.non_converged;
   for (std::uint64_t round = 0;; ++round) {
     const Vector& v = current_velocities(island, bodies);  // (finish_round changes it: not used after)
@@ -53,10 +58,11 @@ void LedasResolver::velocity_complementary(ledas::Island& island, std::span<Rigi
       narrow_start_set(lane, island, v, problem.start);
     }
     problem.rhs = target - v;
-    const std::uint64_t before = lane.stats.velocity.iterations;
+    const auto solves = [&] { return lane.stats.velocity.iterations + lane.stats.velocity.interior_point_steps; };
+    const std::uint64_t before = solves();
     Vector& p = island.impact_solution;
     lane.solver.solve_complementarity(problem, lane.stats.velocity, p);
-    lane.stats.systems += lane.stats.velocity.iterations - before;
+    lane.stats.systems += solves() - before;
     for (std::size_t i = 0; i < m; ++i)
       if (p(static_cast<Eigen::Index>(i)) != 0.0) island.entered[i] = 1;
     finish_round(island, p, target, bodies);

@@ -59,6 +59,7 @@ struct Island {
   ComplementarityWorkspace impact_work, correction_work;
   Vector impact_target, impact_solution, correction_solution;
   std::vector<RowIndex> kept;  ///< a frictional island's correction rows (all but tangent rows)
+  BodySpace body_space;        ///< A's factored form for a problem that suits the interior point
   SparseMatrix restricted;     ///< and A over them
 
   /// A frictional island's impact (frictional_impact.cpp), in buffers kept the same way: the problem
@@ -84,6 +85,14 @@ struct Island {
 /// into `a` (its storage reused); `below` is scratch.
 void assemble_matrix(std::span<const resolution::ImpulseRow> rows, std::span<const std::uint32_t> island,
                      const resolution::Incidence& incidence, SparseMatrix& a, std::vector<int>& below);
+
+/// Whether a problem over `rows` rows of the island may go to the body-space interior point
+/// (SolverSettings::interior_point_rows; body_space.hpp decides finally): worth assembling its G and M.
+bool wants_body_space(const Island& island, std::size_t rows, const SolverSettings& settings);
+
+/// G and M of A = G M⁻¹ Gᵀ (BodySpace) for the island's local rows `local` (all rows if empty), into `out`.
+void assemble_body_space(std::span<const resolution::ImpulseRow> rows, const Island& island,
+                         std::span<const RowIndex> local, std::span<const RigidBody> bodies, BodySpace& out);
 
 /// Kinetic energy of the bodies `which` (J).
 double kinetic_energy(std::span<const RigidBody> bodies, std::span<const BodyIndex> which);

@@ -118,6 +118,7 @@ void IslandSolver::solve_balanced(const ComplementarityProblem& problem, SolverS
   const SparseMatrix scaled = scale.asDiagonal() * a * scale.asDiagonal();
   ComplementarityProblem balanced = problem;
   balanced.matrix = &scaled;
+  balanced.body_space = nullptr;  // G would need the same scaling; the search solves these
   balanced.rhs = scale.cwiseProduct(problem.rhs);
   balanced.tolerance = problem.tolerance / std::sqrt(hi);
   complementarity_->solve(balanced, stats, p);
@@ -145,6 +146,8 @@ void add(SolverStats& into, const SolverStats& part) {
   into.proximal += part.proximal;
   into.refinements += part.refinements;
   into.sharpened += part.sharpened;
+  into.interior_point_steps += part.interior_point_steps;
+  into.interior_point_solved += part.interior_point_solved;
 }
 
 }  // namespace impetus::ledas

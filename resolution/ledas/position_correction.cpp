@@ -54,6 +54,13 @@ void LedasResolver::correct_positions(ledas::Island& island, std::span<RigidBody
     needed = needed || t > kPositionTolerance;
   }
   if (!needed) return;
+  problem.body_space = nullptr;
+  if (ledas::wants_body_space(island, m, solver_settings_)) {
+    ledas::assemble_body_space(rows_, island, island.frictional ? std::span<const ledas::RowIndex>(kept)
+                                                                : std::span<const ledas::RowIndex>(), bodies,
+                               island.body_space);
+    problem.body_space = &island.body_space;
+  }
   const std::uint64_t refused_before = lane.stats.position.refused;
   ledas::Vector& q = island.correction_solution;
   lane.solver.solve_complementarity(problem, lane.stats.position, q);

@@ -225,6 +225,7 @@ TEST(LedasWorld, OptionsAreReadAndChecked) {
   set("search_regularization", "1e-4");
   set("sharpen_refinement", "false");
   set("start_set", "touching");
+  set("interior_point_rows", "0");
   const LedasSettings s = LedasSettings::from_options(options);
   EXPECT_TRUE(options.unread().empty());
   EXPECT_EQ(s.mode, LedasMode::paper);
@@ -233,11 +234,15 @@ TEST(LedasWorld, OptionsAreReadAndChecked) {
   EXPECT_DOUBLE_EQ(s.solver.search_regularization, 1e-4);
   EXPECT_FALSE(s.solver.sharpen_refinement);
   EXPECT_EQ(s.start_set, LedasStartSet::touching);
+  EXPECT_EQ(s.solver.interior_point_rows, 0u);
   EXPECT_DOUBLE_EQ(s.resting.correction, 0.5);
   set("mode", "sequential");
   EXPECT_THROW(LedasSettings::from_options(options), OptionError);
   set("mode", "paper");
   set("start_set", "all");
+  EXPECT_THROW(LedasSettings::from_options(options), OptionError);
+  set("start_set", "impact");
+  set("interior_point_rows", "-1");
   EXPECT_THROW(LedasSettings::from_options(options), OptionError);
 }
 

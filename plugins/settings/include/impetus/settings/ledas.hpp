@@ -61,6 +61,11 @@ struct SolverSettings {
   /// by the search's factorization) may refactor at a smaller shift when it predicts that cheaper than
   /// the steps it would take (refine_on_free_set).
   bool sharpen_refinement = true;
+  /// Complementarity problems of at least this many rows, with more rows than their bodies have
+  /// coordinates (redundant contacts: bricks with four points per face) and no joint row, are solved
+  /// first by a primal–dual interior point in body space, whose system stays positive definite; the
+  /// active-set search takes over if it does not meet the search's own stopping rule. 0: never.
+  std::size_t interior_point_rows = 500;
 };
 
 }  // namespace ledas
@@ -80,7 +85,7 @@ struct LedasSettings {
   /// Complementary mode: the active-set search's first guess. Option `start_set: impact | touching`.
   LedasStartSet start_set = LedasStartSet::impact;
   /// Options `dense_limit`, `polish_limit`, `rank_tolerance`, `update_limit`, `regularization`,
-  /// `search_regularization`, `sharpen_refinement` (max_iterations is set to max_rounds).
+  /// `search_regularization`, `sharpen_refinement`, `interior_point_rows` (max_iterations is set to max_rounds).
   ledas::SolverSettings solver;
   /// Solve each island (rows connected through movable bodies) on its own (default), or every row in
   /// one system (`islands: false`: the same velocities up to rounding, with the bounce threshold judged
@@ -115,6 +120,8 @@ struct LedasSettings {
     s.solver.search_regularization =
         options.number("search_regularization", s.solver.search_regularization, 0.0, 1e-1);
     s.solver.sharpen_refinement = options.boolean("sharpen_refinement", s.solver.sharpen_refinement);
+    s.solver.interior_point_rows = static_cast<std::size_t>(options.integer(
+        "interior_point_rows", static_cast<long long>(s.solver.interior_point_rows), 0, 1'000'000'000));
     s.solver.max_iterations = s.max_rounds;
     s.islands = options.boolean("islands", s.islands);
     s.warm_start = options.boolean("warm_start", s.warm_start);
@@ -138,6 +145,8 @@ struct LedasSettings {
     put(o, "regularization", solver.regularization, d.solver.regularization);
     put(o, "search_regularization", solver.search_regularization, d.solver.search_regularization);
     put(o, "sharpen_refinement", solver.sharpen_refinement, d.solver.sharpen_refinement);
+    put(o, "interior_point_rows", static_cast<long long>(solver.interior_point_rows),
+        static_cast<long long>(d.solver.interior_point_rows));
     put(o, "islands", islands, d.islands);
     put(o, "warm_start", warm_start, d.warm_start);
     resting.add_options(o);

@@ -80,6 +80,8 @@ struct SolverStats {
   std::uint64_t proximal = 0;     ///< proximal outer iterations after the first
   std::uint64_t refinements = 0;  ///< conjugate-gradient steps of exact solves on a candidate free set
   std::uint64_t sharpened = 0;    ///< refinements that refactored at a smaller shift (fewer steps)
+  std::uint64_t interior_point_steps = 0;   ///< body-space interior-point steps (one factorization each)
+  std::uint64_t interior_point_solved = 0;  ///< problems the body-space interior point solved
 };
 
 /// Adds the counts of `part` to `into`.
@@ -116,6 +118,13 @@ struct ComplementarityWorkspace {
   std::unique_ptr<BorderedUpdate> update;           ///< the active-set loop's bordered update (private type)
 };
 
+/// A factored form of A = G M⁻¹ Gᵀ (eq. 7): the rows' Jacobian G (m × n, six columns per movable body:
+/// linear then angular) and the bodies' mass matrix M (n × n, block diagonal, positive definite).
+struct BodySpace {
+  SparseMatrix jacobian;  ///< G: row k's v_n = G_k v for the bodies' velocities v
+  SparseMatrix mass;      ///< M: diag(m I₃, J) per body, J the world-frame inertia
+};
+
 struct ComplementarityProblem {
   const SparseMatrix* matrix = nullptr;  ///< A (m × m), symmetric PSD, both triangles stored
   Vector rhs;                            ///< c (m)
@@ -123,6 +132,9 @@ struct ComplementarityProblem {
   std::vector<char> start;               ///< per row: in the first active set (approaching or touching)
   double tolerance = 1e-9;               ///< w below −tolerance is a violation (units of w)
   ComplementarityWorkspace* workspace = nullptr;  ///< buffers to solve in (null: the solver's own)
+  /// A's factored form, optional: with it a large problem with more rows than body coordinates is
+  /// solved by an interior point in body space first (SolverSettings::interior_point_rows).
+  const BodySpace* body_space = nullptr;
 };
 
 /// Solves island systems exactly: two solvers behind one interface, the equality solver of the paper
