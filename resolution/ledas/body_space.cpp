@@ -42,25 +42,144 @@ bool complementary(const Vector& p, const Vector& w, double tolerance) {
     if (!(w(k) >= -tolerance) || !(p(k) >= 0.0) || p(k) * w(k) > bound) return false;
   return true;
 }
+
+// Products with G, Gᵀ and M from the blocks (BodySpace).
+void multiply_g(const BodySpace& body, const Vector& u, Vector& out) {
+  out.resize(static_cast<Eigen::Index>(body.blocks.size()));
+  for (std::size_t k = 0; k < body.blocks.size(); ++k) {
+    const auto& g = body.jacobian[k];
+    double sum = 0.0;
+    for (int side = 0; side < 2; ++side)
+      if (const std::int32_t b = body.blocks[k][static_cast<std::size_t>(side)]; b >= 0)
+        for (int d = 0; d < 6; ++d) sum += g[static_cast<std::size_t>(6 * side + d)] * u(6 * b + d);
+    out(static_cast<Eigen::Index>(k)) = sum;
+  }
+}
+
+void multiply_g_transpose(const BodySpace& body, const Vector& p, Vector& out) {
+  out.setZero(static_cast<Eigen::Index>(6 * body.mass.size()));
+  for (std::size_t k = 0; k < body.blocks.size(); ++k) {
+    const auto& g = body.jacobian[k];
+    const double pk = p(static_cast<Eigen::Index>(k));
+    for (int side = 0; side < 2; ++side)
+      if (const std::int32_t b = body.blocks[k][static_cast<std::size_t>(side)]; b >= 0)
+        for (int d = 0; d < 6; ++d) out(6 * b + d) += g[static_cast<std::size_t>(6 * side + d)] * pk;
+  }
+}
+
+void multiply_m(const BodySpace& body, const Vector& u, Vector& out) {
+  out.resize(u.size());
+  for (std::size_t b = 0; b < body.mass.size(); ++b) {
+    const auto at = static_cast<Eigen::Index>(6 * b);
+    out.segment<3>(at) = body.mass[b] * u.segment<3>(at);
+    out.segment<3>(at + 3).noalias() = body.inertia[b] * u.segment<3>(at + 3);
+  }
+}
+
+// The pattern of M + Gᵀ D G, 6 × 6 blocks: block column t holds a block for every block s sharing a row
+// with t (and t itself), in increasing s; the six columns of block t have the same rows. Records where
+// each row's four blocks and each diagonal block start, so that system_values() fills it in place.
+void build_pattern(const BodySpace& body, BodySpaceWorkspace& work) {
+  const auto blocks = static_cast<SparseIndex>(body.mass.size());
+  std::vector<std::pair<SparseIndex, SparseIndex>>& pairs = work.pairs;  // (column block, row block)
+  pairs.clear();
+  for (SparseIndex b = 0; b < blocks; ++b) pairs.emplace_back(b, b);
+  for (const auto& [a, b] : body.blocks)
+    if (b >= 0) pairs.emplace_back(a, b), pairs.emplace_back(b, a);
+  std::sort(pairs.begin(), pairs.end());
+  pairs.erase(std::unique(pairs.begin(), pairs.end()), pairs.end());
+  work.neighbour_start.assign(static_cast<std::size_t>(blocks) + 1, 0);
+  work.neighbours.resize(pairs.size());
+  for (std::size_t i = 0; i < pairs.size(); ++i) {
+    ++work.neighbour_start[static_cast<std::size_t>(pairs[i].first) + 1];
+    work.neighbours[i] = pairs[i].second;
+  }
+  for (SparseIndex b = 0; b < blocks; ++b)
+    work.neighbour_start[static_cast<std::size_t>(b) + 1] += work.neighbour_start[static_cast<std::size_t>(b)];
+  const SparseIndex n = 6 * blocks;
+  SparseMatrix& k = work.system;
+  k.resize(n, n);
+  k.resizeNonZeros(static_cast<Eigen::Index>(36 * pairs.size()));
+  SparseIndex at = 0;
+  for (SparseIndex t = 0; t < blocks; ++t) {
+    const SparseIndex first = work.neighbour_start[static_cast<std::size_t>(t)],
+                      last = work.neighbour_start[static_cast<std::size_t>(t) + 1];
+    for (int c = 0; c < 6; ++c) {
+      k.outerIndexPtr()[6 * t + c] = at;
+      for (SparseIndex i = first; i < last; ++i)
+        for (int r = 0; r < 6; ++r) k.innerIndexPtr()[at++] = 6 * work.neighbours[static_cast<std::size_t>(i)] + r;
+    }
+  }
+  k.outerIndexPtr()[n] = at;
+  // Block (s, t) starts at column 6t's start + 6 · (s's place among t's neighbours); its column c is
+  // c · 6 · (t's neighbours) further on.
+  const auto start = [&](SparseIndex s, SparseIndex t) {
+    const auto first = work.neighbours.begin() + work.neighbour_start[static_cast<std::size_t>(t)];
+    const auto last = work.neighbours.begin() + work.neighbour_start[static_cast<std::size_t>(t) + 1];
+    return k.outerIndexPtr()[6 * t] + 6 * static_cast<SparseIndex>(std::lower_bound(first, last, s) - first);
+  };
+  work.diagonal_offsets.resize(static_cast<std::size_t>(blocks));
+  for (SparseIndex b = 0; b < blocks; ++b) work.diagonal_offsets[static_cast<std::size_t>(b)] = start(b, b);
+  work.offsets.resize(body.blocks.size());
+  for (std::size_t r = 0; r < body.blocks.size(); ++r) {
+    const auto [a, b] = body.blocks[r];
+    work.offsets[r] = {start(a, a), b >= 0 ? start(a, b) : 0, b >= 0 ? start(b, a) : 0, b >= 0 ? start(b, b) : 0};
+  }
+}
+
+// Block column t's stride between its columns in `system`.
+SparseIndex stride(const BodySpaceWorkspace& work, SparseIndex t) {
+  return 6 * (work.neighbour_start[static_cast<std::size_t>(t) + 1] - work.neighbour_start[static_cast<std::size_t>(t)]);
+}
+
+// M + Gᵀ diag(d) G into the values of `system`: per row, d_k g_s g_tᵀ added to its blocks (s, t).
+void system_values(const BodySpace& body, const Vector& d, BodySpaceWorkspace& work) {
+  double* value = work.system.valuePtr();
+  std::fill(value, value + work.system.nonZeros(), 0.0);
+  for (std::size_t b = 0; b < body.mass.size(); ++b) {
+    const SparseIndex at = work.diagonal_offsets[b], step = stride(work, static_cast<SparseIndex>(b));
+    for (int c = 0; c < 3; ++c) {
+      value[at + c * step + c] = body.mass[b];
+      for (int r = 0; r < 3; ++r) value[at + (3 + c) * step + 3 + r] = body.inertia[b](r, c);
+    }
+  }
+  const auto add = [value](SparseIndex at, SparseIndex step, double weight, const double* row, const double* column) {
+    for (int c = 0; c < 6; ++c) {
+      const double wc = weight * column[c];
+      double* entry = value + at + c * step;
+      for (int r = 0; r < 6; ++r) entry[r] += wc * row[r];
+    }
+  };
+  for (std::size_t k = 0; k < body.blocks.size(); ++k) {
+    const auto [a, b] = body.blocks[k];
+    const double* g = body.jacobian[k].data();
+    const double dk = d(static_cast<Eigen::Index>(k));
+    const auto& at = work.offsets[k];
+    add(at[0], stride(work, a), dk, g, g);
+    if (b < 0) continue;
+    add(at[1], stride(work, b), dk, g, g + 6);
+    add(at[2], stride(work, a), dk, g + 6, g);
+    add(at[3], stride(work, b), dk, g + 6, g + 6);
+  }
+}
 }  // namespace
 
 bool suits_body_space(const ComplementarityProblem& problem, const SolverSettings& settings) {
   const BodySpace* body = problem.body_space;
   if (body == nullptr || settings.interior_point_rows == 0) return false;
   const auto m = static_cast<std::size_t>(problem.rhs.size());
-  if (m < settings.interior_point_rows || body->jacobian.rows() != problem.rhs.size() ||
-      body->jacobian.cols() >= problem.rhs.size())
+  if (m < settings.interior_point_rows || body->blocks.size() != m || body->jacobian.size() != m ||
+      body->inertia.size() != body->mass.size() || 6 * body->mass.size() >= m)
     return false;
   return std::none_of(problem.equality.begin(), problem.equality.end(), [](char e) { return e != 0; });
 }
 
 bool solve_in_body_space(const ComplementarityProblem& problem, BodySpaceWorkspace& work, SolverStats& stats,
                          Vector& p_out) {
-  const SparseMatrix& g = problem.body_space->jacobian;
-  const SparseMatrix& mass = problem.body_space->mass;
+  const BodySpace& body = *problem.body_space;
   const SparseMatrix& a = *problem.matrix;
   const Vector& c = problem.rhs;
-  const Eigen::Index m = g.rows(), n = g.cols();
+  const auto m = static_cast<Eigen::Index>(body.blocks.size()), n = static_cast<Eigen::Index>(6 * body.mass.size());
   const double tolerance = problem.tolerance;
   const double c_scale = c.lpNorm<Eigen::Infinity>();
   if (!(c_scale > tolerance) || !std::isfinite(c_scale)) return false;  // p = 0 (or nothing sane): the search's
@@ -68,18 +187,23 @@ bool solve_in_body_space(const ComplementarityProblem& problem, BodySpaceWorkspa
   for (Eigen::Index k = 0; k < m; ++k) a_scale = std::max(a_scale, a.coeff(k, k));
   if (!(a_scale > 0.0)) return false;
 
-  work.jacobian_t = g.transpose();
+  build_pattern(body, work);
+  if (!work.analysed || !work.factor.same_pattern(work.system)) {
+    work.factor.analyze(work.system);
+    work.analysed = true;
+  }
+  work.all_rows.assign(static_cast<std::size_t>(n), 1);
   Vector &u = work.u, &p = work.p, &s = work.s;
   u.setZero(n);
   s = ((-c).cwiseMax(0.0).array() + c_scale).matrix();  // strictly interior, of the problem's scale
   p.setConstant(m, c_scale / a_scale);
-  bool analysed = false;
   const double delta = kRegularization * a_scale;
   for (int step = 0; step < kMaxSteps; ++step) {
     // Residuals: dual M u − Gᵀ p, primal G u − c − s, and the mean complementarity μ.
-    work.dual.noalias() = mass * u;
-    work.dual.noalias() -= work.jacobian_t * p;
-    work.primal.noalias() = g * u;
+    multiply_m(body, u, work.dual);
+    multiply_g_transpose(body, p, work.rhs);
+    work.dual -= work.rhs;
+    multiply_g(body, u, work.primal);
     work.primal -= c + s;
     const double mu = p.dot(s) / static_cast<double>(m);
 
@@ -107,18 +231,16 @@ bool solve_in_body_space(const ComplementarityProblem& problem, BodySpaceWorkspa
     // next step's residual takes up.
     //   (M + Gᵀ D G) du = −r_d − Gᵀ D (r_p − P⁻¹ r_c),  dp = −D (G du + r_p − P⁻¹ r_c),  ds = G du + r_p + δ dp.
     work.ratio = (s.cwiseQuotient(p).array() + delta).inverse().matrix();
-    work.system = work.jacobian_t * work.ratio.asDiagonal() * g;
-    work.system += mass;
-    if (!analysed) work.factor.analyzePattern(work.system), analysed = true;
-    work.factor.factorize(work.system);
+    system_values(body, work.ratio, work);
+    // Positive definite by construction (M > 0): no row may be dropped, and none is.
+    if (work.factor.factorize(work.system, work.all_rows, 0.0, 0.0) != 0) return false;
     ++stats.interior_point_steps;
-    if (work.factor.info() != Eigen::Success) return false;
     const auto direction = [&](const Vector& complement, Vector& du, Vector& ds, Vector& dp) {
       work.target = work.ratio.cwiseProduct(work.primal - complement.cwiseQuotient(p));
-      work.rhs.noalias() = -(work.jacobian_t * work.target);
-      work.rhs -= work.dual;
-      du = work.factor.solve(work.rhs);
-      ds.noalias() = g * du;
+      multiply_g_transpose(body, work.target, work.rhs);
+      du = -work.rhs - work.dual;
+      work.factor.solve(du);
+      multiply_g(body, du, ds);
       ds += work.primal;
       dp = -work.ratio.cwiseProduct(ds - complement.cwiseQuotient(p));
       ds += delta * dp;

@@ -4,17 +4,28 @@
 /// (private; resolution/ledas/README.md, "Redundant islands: an interior point in body space").
 
 #include "impetus/resolution/ledas/island_solver.hpp"
+#include "impetus/resolution/ledas/masked_ldlt.hpp"
 
-#include <Eigen/SparseCholesky>
+#include <array>
+#include <cstdint>
+#include <utility>
+#include <vector>
 
 namespace impetus::ledas {
 
-/// The interior point's buffers, kept by the complementarity solver between calls.
+/// The interior point's buffers, kept by the complementarity solver between calls: with them a problem
+/// whose sizes and pattern repeat is solved without allocating, and its symbolic analysis is reused.
 struct BodySpaceWorkspace {
-  SparseMatrix jacobian_t;  ///< Gᵀ
-  SparseMatrix system;      ///< M + Gᵀ D G
-  Eigen::SimplicialLDLT<SparseMatrix, Eigen::Lower> factor;
-  Vector u, p, s, dual, primal, ratio, rhs, du, ds, dp, du_aff, ds_aff, dp_aff, target, complement, candidate, w, check;
+  SparseMatrix system;  ///< M + Gᵀ D G (both triangles), its pattern built per problem
+  MaskedLdlt factor;    ///< its LDLᵀ; analysed again only when the pattern changes
+  bool analysed = false;
+  std::vector<char> all_rows;                          ///< every row of `system` in the factorization
+  std::vector<SparseIndex> neighbour_start, neighbours;  ///< per block: the blocks it shares a row with (and itself)
+  std::vector<std::array<SparseIndex, 4>> offsets;     ///< per row: where its blocks aa, ab, ba, bb start in `system`
+  std::vector<SparseIndex> diagonal_offsets;           ///< per block: where its own block starts
+  std::vector<std::pair<SparseIndex, SparseIndex>> pairs;  ///< build_pattern's scratch
+  Vector u, p, s, dual, primal, ratio, rhs, du, ds, dp, du_aff, ds_aff, dp_aff, target, complement, candidate, w,
+      check;
 };
 
 /// Whether `problem` goes to the interior point first: it brings its body-space form, has no equality

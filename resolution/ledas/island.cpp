@@ -75,41 +75,38 @@ bool wants_body_space(const Island& island, std::size_t rows, const SolverSettin
 }
 
 // Row k's v_n = (u_b − u_a)·n at its points: −(n, r_a × n) on body a's coordinates (v, ω), +(n, r_b × n)
-// on b's; fixed bodies have no columns. A row with the same body on both sides sums the two.
+// on b's; fixed bodies have no block. A row with the same body on both sides has the sum on one block.
 void assemble_body_space(std::span<const resolution::ImpulseRow> rows, const Island& island,
                          std::span<const RowIndex> local, std::span<const RigidBody> bodies, BodySpace& out) {
   const std::size_t m = local.empty() ? island.rows.size() : local.size();
-  const auto n = static_cast<Eigen::Index>(6 * island.bodies.size());
-  std::vector<Eigen::Triplet<double>> entries;
-  entries.reserve(12 * m);
+  out.blocks.resize(m);
+  out.jacobian.resize(m);
   for (std::size_t j = 0; j < m; ++j) {
     const std::size_t i = local.empty() ? j : local[j];
     const resolution::ImpulseRow& row = rows[island.rows[i]];
-    const auto& slots = island.incidence.slots[i];
-    const auto put = [&](std::int32_t slot, double sign, const Vec3& arm) {
-      if (slot < 0) return;
-      const auto first = static_cast<Eigen::Index>(6 * slot), r = static_cast<Eigen::Index>(j);
-      for (int d = 0; d < 3; ++d) {
-        entries.emplace_back(r, first + d, sign * row.normal(d));
-        entries.emplace_back(r, first + 3 + d, sign * arm(d));
-      }
-    };
-    put(slots[0], -1.0, row.arm_a);
-    put(slots[1], +1.0, row.arm_b);
+    std::array<std::int32_t, 2> sides = island.incidence.slots[i];
+    std::array<double, 12>& g = out.jacobian[j];
+    for (int d = 0; d < 3; ++d) {
+      g[d] = -row.normal(d), g[3 + d] = -row.arm_a(d);
+      g[6 + d] = row.normal(d), g[9 + d] = row.arm_b(d);
+    }
+    if (sides[0] < 0) {  // only side b is movable: it becomes the first
+      std::copy(g.begin() + 6, g.end(), g.begin());
+      sides = {sides[1], -1};
+    } else if (sides[1] == sides[0]) {
+      for (int d = 0; d < 6; ++d) g[d] += g[6 + d];
+      sides[1] = -1;
+    }
+    if (sides[1] < 0) std::fill(g.begin() + 6, g.end(), 0.0);
+    out.blocks[j] = sides;
   }
-  out.jacobian.resize(static_cast<Eigen::Index>(m), n);
-  out.jacobian.setFromTriplets(entries.begin(), entries.end());
-  entries.clear();
+  out.mass.resize(island.bodies.size());
+  out.inertia.resize(island.bodies.size());
   for (std::size_t s = 0; s < island.bodies.size(); ++s) {
     const RigidBody& body = bodies[island.bodies[s]];
-    const Mat3 inertia = body.inertia_world();
-    const auto first = static_cast<Eigen::Index>(6 * s);
-    for (int d = 0; d < 3; ++d) entries.emplace_back(first + d, first + d, body.mass);
-    for (int r = 0; r < 3; ++r)
-      for (int c = 0; c < 3; ++c) entries.emplace_back(first + 3 + r, first + 3 + c, inertia(r, c));
+    out.mass[s] = body.mass;
+    out.inertia[s] = body.inertia_world();
   }
-  out.mass.resize(n, n);
-  out.mass.setFromTriplets(entries.begin(), entries.end());
 }
 
 double kinetic_energy(std::span<const RigidBody> bodies, std::span<const BodyIndex> which) {

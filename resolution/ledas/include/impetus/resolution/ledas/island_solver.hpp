@@ -33,6 +33,7 @@
 #include <Eigen/SparseCholesky>
 #include <Eigen/SparseCore>
 
+#include <array>
 #include <cstdint>
 #include <memory>
 #include <span>
@@ -118,11 +119,14 @@ struct ComplementarityWorkspace {
   std::unique_ptr<BorderedUpdate> update;           ///< the active-set loop's bordered update (private type)
 };
 
-/// A factored form of A = G M⁻¹ Gᵀ (eq. 7): the rows' Jacobian G (m × n, six columns per movable body:
-/// linear then angular) and the bodies' mass matrix M (n × n, block diagonal, positive definite).
+/// A factored form of A = G M⁻¹ Gᵀ (eq. 7) in blocks of six coordinates (a movable body's linear, then
+/// angular velocity): row k's v_n = G_k v touches the blocks of its two sides; M is block diagonal,
+/// diag(m I₃, J) per block.
 struct BodySpace {
-  SparseMatrix jacobian;  ///< G: row k's v_n = G_k v for the bodies' velocities v
-  SparseMatrix mass;      ///< M: diag(m I₃, J) per body, J the world-frame inertia
+  std::vector<std::array<std::int32_t, 2>> blocks;  ///< per row: the blocks of sides a and b (−1: none)
+  std::vector<std::array<double, 12>> jacobian;     ///< per row: G on side a's six coordinates, then b's
+  std::vector<double> mass;                         ///< per block: m (kg)
+  std::vector<Eigen::Matrix3d> inertia;             ///< per block: J (kg·m², world frame)
 };
 
 struct ComplementarityProblem {
