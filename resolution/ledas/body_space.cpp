@@ -11,11 +11,12 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 namespace impetus::ledas {
 
 namespace {
-constexpr int kMaxSteps = 40;            // Mehrotra's method takes 10–20 on the problems it is used for
+constexpr int kMaxSteps = 100;  // the wall of 200 bricks takes 9–20 steps per problem, of 1,000 bricks 27–50
 constexpr double kStepFraction = 0.99;   // of the longest step that keeps s, p > 0
 constexpr double kRegularization = 1e-10;  // δ = this · max A_kk (below)
 // The stopping rule's bound on each row's p_k w_k, in units of tolerance · max p. Each factor 100 costs
@@ -24,6 +25,7 @@ constexpr double kRegularization = 1e-10;  // δ = this · max A_kk (below)
 // 1e-2 / 1e-4 / 1e-6, in 10 / 11 / 12 / 13 steps; at 1e-6 the knocked wall's hardest problems no
 // longer get there before the regularization's floor and fall back to the search.
 constexpr double kComplementarity = 1e-4;
+constexpr int kStallSteps = 10;  // steps without a better iterate before the search takes over
 
 // The longest step α ≤ 1 with x + α dx ≥ 0.
 double longest_step(const Vector& x, const Vector& dx) {
@@ -33,14 +35,22 @@ double longest_step(const Vector& x, const Vector& dx) {
   return alpha;
 }
 
-// The interior point's stopping rule on p ≥ 0 and w = A p − c: no row approaches (w ≥ −tolerance) and
-// every row's complementarity product is at most kComplementarity · tolerance · max p (a row that
-// separates by w carries at most kComplementarity · tolerance / w of the largest impulse).
-bool complementary(const Vector& p, const Vector& w, double tolerance) {
-  const double bound = kComplementarity * tolerance * p.lpNorm<Eigen::Infinity>();
-  for (Eigen::Index k = 0; k < p.size(); ++k)
-    if (!(w(k) >= -tolerance) || !(p(k) >= 0.0) || p(k) * w(k) > bound) return false;
-  return true;
+// The interior point's stopping rule on p ≥ 0 and w = A p − c, as the worst ratio to its bounds (≤ 1:
+// met): no row approaches (w ≥ −tolerance), and every row's complementarity product is at most
+// max(kComplementarity · tolerance, rounding) · max p, so a row that separates by w carries at most that
+// over w of the largest impulse. `rounding` is the search's floor for w, 1e-14 (max A_kk · max p + max
+// |c|): on the wall of 1,000 bricks (impulses up to ~100 N·s) the products stalled at 1e-11, where
+// 1e-4 · tolerance · max p is 1e-11 too.
+double excess(const Vector& p, const Vector& w, const Vector& c, double tolerance, double a_scale) {
+  const double largest = p.lpNorm<Eigen::Infinity>();
+  const double rounding = 1e-14 * (a_scale * largest + c.lpNorm<Eigen::Infinity>());
+  const double bound = std::max(kComplementarity * tolerance, rounding) * largest;
+  double worst = 0.0;
+  for (Eigen::Index k = 0; k < p.size(); ++k) {
+    if (!(p(k) >= 0.0) || !std::isfinite(w(k))) return std::numeric_limits<double>::infinity();
+    worst = std::max({worst, -w(k) / tolerance, bound > 0.0 ? p(k) * w(k) / bound : 0.0});
+  }
+  return worst;
 }
 
 // Products with G, Gᵀ and M from the blocks (BodySpace).
@@ -198,6 +208,8 @@ bool solve_in_body_space(const ComplementarityProblem& problem, BodySpaceWorkspa
   s = ((-c).cwiseMax(0.0).array() + c_scale).matrix();  // strictly interior, of the problem's scale
   p.setConstant(m, c_scale / a_scale);
   const double delta = kRegularization * a_scale;
+  double best = std::numeric_limits<double>::infinity();
+  int best_step = 0;
   for (int step = 0; step < kMaxSteps; ++step) {
     // Residuals: dual M u − Gᵀ p, primal G u − c − s, and the mean complementarity μ.
     multiply_m(body, u, work.dual);
@@ -210,7 +222,10 @@ bool solve_in_body_space(const ComplementarityProblem& problem, BodySpaceWorkspa
     // Judged on the impulses themselves: w = A p − c, which carries the dual residual's error.
     work.w.noalias() = a * p;
     work.w -= c;
-    if (complementary(p, work.w, tolerance)) {
+    const double worst = excess(p, work.w, c, tolerance, a_scale);
+    if (worst < best) best = worst, best_step = step;
+    if (step - best_step > kStallSteps) return false;  // at the regularization's or rounding's floor
+    if (worst <= 1.0) {
       // The rows that separate by more than the tolerance let go of their (small) impulses if the rule
       // still holds without them.
       work.candidate = p;
@@ -218,7 +233,7 @@ bool solve_in_body_space(const ComplementarityProblem& problem, BodySpaceWorkspa
         if (work.w(k) > tolerance) work.candidate(k) = 0.0;
       work.check.noalias() = a * work.candidate;
       work.check -= c;
-      p_out = complementary(work.candidate, work.check, tolerance) ? work.candidate : p;
+      p_out = excess(work.candidate, work.check, c, tolerance, a_scale) <= 1.0 ? work.candidate : p;
       ++stats.interior_point_solved;
       return true;
     }

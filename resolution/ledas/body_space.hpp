@@ -35,9 +35,10 @@ bool suits_body_space(const ComplementarityProblem& problem, const SolverSetting
 
 /// Solves the problem's convex QP min ½ uᵀM u s.t. G u ≥ c (u = M⁻¹Gᵀp, the velocity change) by
 /// Mehrotra's predictor–corrector; its multipliers are p. Returns true, with p, once p ≥ 0 and
-/// w = A p − c meet the ε-complementarity rule: w ≥ −tolerance on every row and p_k w_k ≤ 1e-4 ·
-/// tolerance · max p (rows separating by more than the tolerance then let go of their impulses if the
-/// rule still holds without them). Otherwise (no convergence within its step cap) false, p untouched.
+/// w = A p − c meet the ε-complementarity rule: w ≥ −tolerance on every row and p_k w_k ≤
+/// max(1e-4 · tolerance, rounding) · max p (rows separating by more than the tolerance then let go of
+/// their impulses if the rule still holds without them). Otherwise (its step cap, a stall, a pivot ≤ 0)
+/// false, p untouched.
 bool solve_in_body_space(const ComplementarityProblem& problem, BodySpaceWorkspace& work, SolverStats& stats,
                          Vector& p);
 
