@@ -181,6 +181,9 @@ bool suits_body_space(const ComplementarityProblem& problem, const SolverSetting
   if (m < settings.interior_point_rows || body->blocks.size() != m || body->jacobian.size() != m ||
       body->inertia.size() != body->mass.size() || 6 * body->mass.size() >= m)
     return false;
+  const auto blocks = static_cast<std::int32_t>(body->mass.size());
+  for (const auto& [a, b] : body->blocks)  // side a movable, side b movable or none (assemble_body_space)
+    if (a < 0 || a >= blocks || b < -1 || b >= blocks) return false;
   return std::none_of(problem.equality.begin(), problem.equality.end(), [](char e) { return e != 0; });
 }
 
