@@ -26,6 +26,15 @@ constexpr double kRegularization = 1e-10;  // δ = this · max A_kk (below)
 // longer get there before the regularization's floor and fall back to the search.
 constexpr double kComplementarity = 1e-4;
 constexpr int kStallSteps = 10;  // steps without a better iterate before the search takes over
+// Gondzio's multiple centrality correctors (J. Gondzio, "Multiple centrality corrections in a primal-dual
+// method for linear programming", Comput. Optim. Appl. 6, 1996): at most kCorrectors per step, each one
+// more solve on the step's factorization, aimed at the trial step min(1, 1.5 α + 0.1) and kept only if it
+// lengthens the step by 1%. On the 7 problems dumped from the knocked wall (a scratch driver) the steps
+// fell from 162 in all to 134 with 2 correctors and 129 with 4.
+constexpr int kCorrectors = 2;
+constexpr double kTrialStretch = 1.5, kTrialReach = 0.1;
+constexpr double kCentreLow = 0.1, kCentreHigh = 10.0;  // the products' band, in units of σμ
+constexpr double kCorrectorGain = 1.01;
 
 // The longest step α ≤ 1 with x + α dx ≥ 0.
 double longest_step(const Vector& x, const Vector& dx) {
@@ -86,9 +95,9 @@ void multiply_m(const BodySpace& body, const Vector& u, Vector& out) {
   }
 }
 
-// The pattern of M + Gᵀ D G, 6 × 6 blocks: block column t holds a block for every block s sharing a row
-// with t (and t itself), in increasing s; the six columns of block t have the same rows. Records where
-// each row's four blocks and each diagonal block start, so that system_values() fills it in place.
+// The block pattern of M + Gᵀ D G: block column t holds a block for every body s sharing a row with t
+// (and t itself), in increasing s. Records where each row's four blocks and each body's diagonal block
+// are, so that system_values() fills it in place.
 void build_pattern(const BodySpace& body, BodySpaceWorkspace& work) {
   const auto blocks = static_cast<SparseIndex>(body.mass.size());
   std::vector<std::pair<SparseIndex, SparseIndex>>& pairs = work.pairs;  // (column block, row block)
@@ -106,70 +115,43 @@ void build_pattern(const BodySpace& body, BodySpaceWorkspace& work) {
   }
   for (SparseIndex b = 0; b < blocks; ++b)
     work.neighbour_start[static_cast<std::size_t>(b) + 1] += work.neighbour_start[static_cast<std::size_t>(b)];
-  const SparseIndex n = 6 * blocks;
-  SparseMatrix& k = work.system;
-  k.resize(n, n);
-  k.resizeNonZeros(static_cast<Eigen::Index>(36 * pairs.size()));
-  SparseIndex at = 0;
-  for (SparseIndex t = 0; t < blocks; ++t) {
-    const SparseIndex first = work.neighbour_start[static_cast<std::size_t>(t)],
-                      last = work.neighbour_start[static_cast<std::size_t>(t) + 1];
-    for (int c = 0; c < 6; ++c) {
-      k.outerIndexPtr()[6 * t + c] = at;
-      for (SparseIndex i = first; i < last; ++i)
-        for (int r = 0; r < 6; ++r) k.innerIndexPtr()[at++] = 6 * work.neighbours[static_cast<std::size_t>(i)] + r;
-    }
-  }
-  k.outerIndexPtr()[n] = at;
-  // Block (s, t) starts at column 6t's start + 6 · (s's place among t's neighbours); its column c is
-  // c · 6 · (t's neighbours) further on.
-  const auto start = [&](SparseIndex s, SparseIndex t) {
+  work.system.resize(pairs.size());
+  // Block (s, t): column t's block at s's place among t's neighbours.
+  const auto place = [&](SparseIndex s, SparseIndex t) {
     const auto first = work.neighbours.begin() + work.neighbour_start[static_cast<std::size_t>(t)];
     const auto last = work.neighbours.begin() + work.neighbour_start[static_cast<std::size_t>(t) + 1];
-    return k.outerIndexPtr()[6 * t] + 6 * static_cast<SparseIndex>(std::lower_bound(first, last, s) - first);
+    return static_cast<SparseIndex>(std::lower_bound(first, last, s) - work.neighbours.begin());
   };
   work.diagonal_offsets.resize(static_cast<std::size_t>(blocks));
-  for (SparseIndex b = 0; b < blocks; ++b) work.diagonal_offsets[static_cast<std::size_t>(b)] = start(b, b);
+  for (SparseIndex b = 0; b < blocks; ++b) work.diagonal_offsets[static_cast<std::size_t>(b)] = place(b, b);
   work.offsets.resize(body.blocks.size());
   for (std::size_t r = 0; r < body.blocks.size(); ++r) {
     const auto [a, b] = body.blocks[r];
-    work.offsets[r] = {start(a, a), b >= 0 ? start(a, b) : 0, b >= 0 ? start(b, a) : 0, b >= 0 ? start(b, b) : 0};
+    work.offsets[r] = {place(a, a), b >= 0 ? place(a, b) : 0, b >= 0 ? place(b, a) : 0, b >= 0 ? place(b, b) : 0};
   }
 }
 
-// Block column t's stride between its columns in `system`.
-SparseIndex stride(const BodySpaceWorkspace& work, SparseIndex t) {
-  return 6 * (work.neighbour_start[static_cast<std::size_t>(t) + 1] - work.neighbour_start[static_cast<std::size_t>(t)]);
-}
-
-// M + Gᵀ diag(d) G into the values of `system`: per row, d_k g_s g_tᵀ added to its blocks (s, t).
+// M + Gᵀ diag(d) G into `system`: per row, d_k g_s g_tᵀ added to its blocks (s, t).
 void system_values(const BodySpace& body, const Vector& d, BodySpaceWorkspace& work) {
-  double* value = work.system.valuePtr();
-  std::fill(value, value + work.system.nonZeros(), 0.0);
+  using Block = BlockLdlt::Block;
+  using Row = Eigen::Map<const Eigen::Matrix<double, 6, 1>>;
+  std::fill(work.system.begin(), work.system.end(), Block::Zero());
   for (std::size_t b = 0; b < body.mass.size(); ++b) {
-    const SparseIndex at = work.diagonal_offsets[b], step = stride(work, static_cast<SparseIndex>(b));
-    for (int c = 0; c < 3; ++c) {
-      value[at + c * step + c] = body.mass[b];
-      for (int r = 0; r < 3; ++r) value[at + (3 + c) * step + 3 + r] = body.inertia[b](r, c);
-    }
+    Block& diagonal = work.system[static_cast<std::size_t>(work.diagonal_offsets[b])];
+    diagonal.topLeftCorner<3, 3>().diagonal().setConstant(body.mass[b]);
+    diagonal.bottomRightCorner<3, 3>() = body.inertia[b];
   }
-  const auto add = [value](SparseIndex at, SparseIndex step, double weight, const double* row, const double* column) {
-    for (int c = 0; c < 6; ++c) {
-      const double wc = weight * column[c];
-      double* entry = value + at + c * step;
-      for (int r = 0; r < 6; ++r) entry[r] += wc * row[r];
-    }
-  };
   for (std::size_t k = 0; k < body.blocks.size(); ++k) {
-    const auto [a, b] = body.blocks[k];
-    const double* g = body.jacobian[k].data();
+    const std::int32_t b = body.blocks[k][1];
+    const Row ga(body.jacobian[k].data()), gb(body.jacobian[k].data() + 6);
     const double dk = d(static_cast<Eigen::Index>(k));
     const auto& at = work.offsets[k];
-    add(at[0], stride(work, a), dk, g, g);
+    const auto block = [&work](SparseIndex i) -> Block& { return work.system[static_cast<std::size_t>(i)]; };
+    block(at[0]).noalias() += (dk * ga) * ga.transpose();
     if (b < 0) continue;
-    add(at[1], stride(work, b), dk, g, g + 6);
-    add(at[2], stride(work, a), dk, g + 6, g);
-    add(at[3], stride(work, b), dk, g + 6, g + 6);
+    block(at[1]).noalias() += (dk * ga) * gb.transpose();
+    block(at[2]).noalias() += (dk * gb) * ga.transpose();
+    block(at[3]).noalias() += (dk * gb) * gb.transpose();
   }
 }
 }  // namespace
@@ -201,11 +183,10 @@ bool solve_in_body_space(const ComplementarityProblem& problem, BodySpaceWorkspa
   if (!(a_scale > 0.0)) return false;
 
   build_pattern(body, work);
-  if (!work.analysed || !work.factor.same_pattern(work.system)) {
-    work.factor.analyze(work.system);
+  if (!work.analysed || !work.factor.same_pattern(work.neighbour_start, work.neighbours)) {
+    work.factor.analyze(work.neighbour_start, work.neighbours);
     work.analysed = true;
   }
-  work.all_rows.assign(static_cast<std::size_t>(n), 1);
   Vector &u = work.u, &p = work.p, &s = work.s;
   u.setZero(n);
   s = ((-c).cwiseMax(0.0).array() + c_scale).matrix();  // strictly interior, of the problem's scale
@@ -250,29 +231,55 @@ bool solve_in_body_space(const ComplementarityProblem& problem, BodySpaceWorkspa
     //   (M + Gᵀ D G) du = −r_d − Gᵀ D (r_p − P⁻¹ r_c),  dp = −D (G du + r_p − P⁻¹ r_c),  ds = G du + r_p + δ dp.
     work.ratio = (s.cwiseQuotient(p).array() + delta).inverse().matrix();
     system_values(body, work.ratio, work);
-    // Positive definite by construction (M > 0): no row may be dropped, and none is.
-    if (work.factor.factorize(work.system, work.all_rows, 0.0, 0.0) != 0) return false;
+    // Positive definite by construction (M > 0): a pivot block that is not means rounding has won.
+    if (!work.factor.factorize(work.system)) return false;
     ++stats.interior_point_steps;
-    const auto direction = [&](const Vector& complement, Vector& du, Vector& ds, Vector& dp) {
-      work.target = work.ratio.cwiseProduct(work.primal - complement.cwiseQuotient(p));
+    // With `residuals` false, the direction that changes only the complementarity products (a corrector).
+    const auto direction = [&](const Vector& complement, bool residuals, Vector& du, Vector& ds, Vector& dp) {
+      work.target = -complement.cwiseQuotient(p);
+      if (residuals) work.target += work.primal;
+      work.target = work.ratio.cwiseProduct(work.target);
       multiply_g_transpose(body, work.target, work.rhs);
-      du = -work.rhs - work.dual;
+      du = -work.rhs;
+      if (residuals) du -= work.dual;
       work.factor.solve(du);
       multiply_g(body, du, ds);
-      ds += work.primal;
+      if (residuals) ds += work.primal;
       dp = -work.ratio.cwiseProduct(ds - complement.cwiseQuotient(p));
       ds += delta * dp;
     };
     // Predictor (affine scaling), then the corrector with centring σ = (μ_aff / μ)³.
     work.complement = -p.cwiseProduct(s);
-    direction(work.complement, work.du_aff, work.ds_aff, work.dp_aff);
+    direction(work.complement, true, work.du_aff, work.ds_aff, work.dp_aff);
     const double primal_aff = longest_step(s, work.ds_aff), dual_aff = longest_step(p, work.dp_aff);
     const double mu_aff =
         (s + primal_aff * work.ds_aff).dot(p + dual_aff * work.dp_aff) / static_cast<double>(m);
     const double sigma = std::pow(mu_aff / mu, 3);
     work.complement = (sigma * mu - p.cwiseProduct(s).array() - work.ds_aff.cwiseProduct(work.dp_aff).array()).matrix();
-    direction(work.complement, work.du, work.ds, work.dp);
-    const double alpha = kStepFraction * std::min(longest_step(s, work.ds), longest_step(p, work.dp));
+    direction(work.complement, true, work.du, work.ds, work.dp);
+    double alpha = std::min(longest_step(s, work.ds), longest_step(p, work.dp));
+    // Gondzio's centrality correctors: at a trial point past the step the direction allows, pull the
+    // products p_k s_k that left [0.1, 10] · σμ back into it, kept while they lengthen the step.
+    for (int corrector = 0; corrector < kCorrectors && alpha < 1.0; ++corrector) {
+      const double trial = std::min(1.0, kTrialStretch * alpha + kTrialReach);
+      const double centre = sigma * mu;
+      for (Eigen::Index k = 0; k < m; ++k) {
+        const double product = (s(k) + trial * work.ds(k)) * (p(k) + trial * work.dp(k));
+        work.complement(k) = std::max(std::clamp(product, kCentreLow * centre, kCentreHigh * centre) - product,
+                                      -kCentreHigh * centre);
+      }
+      direction(work.complement, false, work.du_aff, work.ds_aff, work.dp_aff);
+      work.du_aff += work.du;
+      work.ds_aff += work.ds;
+      work.dp_aff += work.dp;
+      const double longer = std::min(longest_step(s, work.ds_aff), longest_step(p, work.dp_aff));
+      if (!(longer >= kCorrectorGain * alpha)) break;
+      work.du.swap(work.du_aff);
+      work.ds.swap(work.ds_aff);
+      work.dp.swap(work.dp_aff);
+      alpha = longer;
+    }
+    alpha *= kStepFraction;
     u += alpha * work.du;
     s += alpha * work.ds;
     p += alpha * work.dp;

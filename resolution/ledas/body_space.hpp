@@ -4,7 +4,7 @@
 /// (private; resolution/ledas/README.md, "Redundant islands: an interior point in body space").
 
 #include "impetus/resolution/ledas/island_solver.hpp"
-#include "impetus/resolution/ledas/masked_ldlt.hpp"
+#include "impetus/resolution/ledas/block_ldlt.hpp"
 
 #include <array>
 #include <cstdint>
@@ -16,13 +16,12 @@ namespace impetus::ledas {
 /// The interior point's buffers, kept by the complementarity solver between calls: with them a problem
 /// whose sizes and pattern repeat is solved without allocating, and its symbolic analysis is reused.
 struct BodySpaceWorkspace {
-  SparseMatrix system;  ///< M + Gᵀ D G (both triangles), its pattern built per problem
-  MaskedLdlt factor;    ///< its LDLᵀ; analysed again only when the pattern changes
+  std::vector<BlockLdlt::Block> system;  ///< M + Gᵀ D G by 6 × 6 blocks, on the pattern `neighbours`
+  BlockLdlt factor;                      ///< its LDLᵀ; analysed again only when the pattern changes
   bool analysed = false;
-  std::vector<char> all_rows;                          ///< every row of `system` in the factorization
-  std::vector<SparseIndex> neighbour_start, neighbours;  ///< per block: the blocks it shares a row with (and itself)
-  std::vector<std::array<SparseIndex, 4>> offsets;     ///< per row: where its blocks aa, ab, ba, bb start in `system`
-  std::vector<SparseIndex> diagonal_offsets;           ///< per block: where its own block starts
+  std::vector<SparseIndex> neighbour_start, neighbours;  ///< per block column: the blocks it shares a row with (and itself)
+  std::vector<std::array<SparseIndex, 4>> offsets;     ///< per row: its blocks aa, ab, ba, bb in `system`
+  std::vector<SparseIndex> diagonal_offsets;           ///< per body: its own block
   std::vector<std::pair<SparseIndex, SparseIndex>> pairs;  ///< build_pattern's scratch
   Vector u, p, s, dual, primal, ratio, rhs, du, ds, dp, du_aff, ds_aff, dp_aff, target, complement, candidate, w,
       check;

@@ -90,7 +90,7 @@ Outcome resolve_wall(bool moving, double ground_depth, std::size_t interior_poin
 // stops on its ε-complementarity rule (no contact approaches by more than the tolerance, every
 // contact's impulse × separation at most 1e-4 · tolerance × the largest impulse). Its velocities are
 // the active-set search's (the velocities of the problem are unique; the impulses are not) to within the
-// tolerance, 1e-9 m/s and rad/s (2.5e-11 measured), and it spends no active-set iteration.
+// tolerance, 1e-9 m/s and rad/s (5.7e-11 measured), and it spends no active-set iteration.
 TEST(LedasBodySpace, RedundantWallMatchesTheActiveSetSearch) {
   const std::vector<Contact> contacts = wall_contacts(0.0);
   const std::size_t rows = contacts.size();
@@ -156,9 +156,8 @@ TEST(LedasBodySpace, CorrectionLiftsASunkenWallUniformly) {
 }
 
 // Determinism: a wall of 200 cubes (1,200 coordinates, 1,568 rows) resolved in a task arena of one
-// thread and of four gives the same velocities and impulses to the bit. (The interior point factorizes
-// with the masked LDLᵀ, whose parallel subtrees give the serial bits: MaskedLdlt.ParallelSubtrees…; this
-// wall's elimination tree is not split, the knocked wall's sometimes is.)
+// thread and of four gives the same velocities and impulses to the bit. (The interior point's block
+// LDLᵀ is serial; what threads could change is the island's other work around it.)
 TEST(LedasBodySpace, SameBitsForEveryThreadCount) {
   constexpr int kTall = 8, kWide = 25;
   std::vector<RigidBody> serial = cube_wall(true, kTall, kWide), parallel = serial;
