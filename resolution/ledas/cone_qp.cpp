@@ -24,6 +24,13 @@ constexpr double kStepToBoundary = 0.99;
 // The shift of the joint rows' diagonal (× max P_ii): they have no barrier term, and redundant joints
 // would leave P + T² singular there.
 constexpr double kFreeShift = 1e-12;
+// Gondzio's centrality correctors (as in body_space.cpp): at most kCorrectors per step, aimed at the trial
+// step min(1, kTrialStretch · α + kTrialReach), the products' band [kCentreLow, kCentreHigh] · σμ, kept
+// if the step grows by the factor kCorrectorGain.
+constexpr int kCorrectors = 2;
+constexpr double kTrialStretch = 1.5, kTrialReach = 0.1;
+constexpr double kCentreLow = 0.1, kCentreHigh = 10.0;
+constexpr double kCorrectorGain = 1.01;
 
 using Cone = ConeQpWorkspace::Cone;
 using Scaling = ConeQpWorkspace::Scaling;
@@ -266,9 +273,10 @@ void solve_cone_qp(const FrictionalProblem& problem, double target, std::uint64_
     if (numerical_end) break;
     ldlt.factorize(ws.h, ws.every_row, 0.0, 0.0);
 
-    // (P + T²) Δx = −r_d + T η,  Δz = T η − T² Δx,  with λ ∘ η = ξ per cone.
-    const auto direction = [&](Vector& dx, Vector& dz) {
-      dx = -rd;
+    // (P + T²) Δx = −r_d + T η,  Δz = T η − T² Δx,  with λ ∘ η = ξ per cone (without −r_d: a corrector).
+    const auto direction = [&](Vector& dx, Vector& dz, bool residual = true) {
+      if (residual) dx = -rd;
+      else dx.setZero(m);
       for (std::size_t n = 0; n < cones.size(); ++n) {
         const Cone& k = cones[n];
         if (k.free) continue;
@@ -310,7 +318,30 @@ void solve_cone_qp(const FrictionalProblem& problem, double target, std::uint64_
     Vector &dx = ws.dx, &dz = ws.dz;
     direction(dx, dz);
     if (!dx.allFinite() || !dz.allFinite()) break;
-    const double alpha = std::min(1.0, kStepToBoundary * max_step(cones, x, dx, z, dz));
+    double reach = max_step(cones, x, dx, z, dz);
+    // Gondzio's centrality correctors, per cone on the products x_kᵀz_k (the first component of x ∘ z,
+    // μ on the central path): at the trial step min(1, 1.5 α + 0.1), those outside [0.1, 10] · σμ are
+    // pulled back into the band along e, by one more solve each; kept while the step grows by 1%.
+    for (int corrector = 0; corrector < kCorrectors && reach < 1.0; ++corrector) {
+      const double trial = std::min(1.0, kTrialStretch * reach + kTrialReach), centre = sigma * mu;
+      for (std::size_t n = 0; n < cones.size(); ++n) {
+        const Cone& k = cones[n];
+        if (k.free) continue;
+        const double product = (block(x, k) + trial * block(dx, k)).dot(block(z, k) + trial * block(dz, k));
+        const double pull =
+            std::max(std::clamp(product, kCentreLow * centre, kCentreHigh * centre) - product, -kCentreHigh * centre);
+        eta[n] = jordan_divide(scaling[n].lambda, Vec3(pull, 0.0, 0.0), k.size);
+      }
+      direction(dx_aff, dz_aff, false);
+      dx_aff += dx;
+      dz_aff += dz;
+      const double longer = max_step(cones, x, dx_aff, z, dz_aff);
+      if (!dx_aff.allFinite() || !dz_aff.allFinite() || !(longer >= kCorrectorGain * reach)) break;
+      dx.swap(dx_aff);
+      dz.swap(dz_aff);
+      reach = longer;
+    }
+    const double alpha = std::min(1.0, kStepToBoundary * reach);
     x += alpha * dx;
     z += alpha * dz;
   }
