@@ -85,6 +85,14 @@ struct FrictionalWorkspace::Newton {
   MaskedLdlt ldlt;
   std::vector<char> active;
   Vector rhs;
+  // What ldlt's last factorization by symmetric_direction was of (which W, the active rows, the shift)
+  // and its number (MaskedLdlt::factorizations): a step with the same matrix reuses it. Forgotten
+  // (factored_number = 0) whenever a W it may have been may change: at each solve() and when the
+  // proximal stage shifts its copy of W.
+  const SparseMatrix* factored_w = nullptr;
+  std::vector<char> factored_active;
+  double factored_shift = 0.0;
+  std::uint64_t factored_number = 0;
   // The cold path's (solve, solve_stages, proximal_newton): kept so that a cold solve of a problem with
   // the last one's pattern allocates nothing either (where no contact slides above `dense_limit`).
   ConeQpWorkspace cone_qp;
@@ -319,7 +327,19 @@ bool symmetric_direction(const std::vector<Block>& blocks, const std::vector<Lin
   }
   MaskedLdlt& ldlt = buffers.ldlt;
   if (!ldlt.same_pattern(w)) ldlt.analyze(w);
-  ldlt.factorize(w, active, shift > 0.0 ? 0.0 : kRankTolerance, 0.0, shift);
+  // The same matrix as the last step's (a step that keeps the active set, as Newton's last steps near a
+  // solution do, and nothing factorized in between): its factorization, bit for bit the one a new
+  // factorization would give, is reused.
+  const bool same_matrix = buffers.factored_number != 0 && ldlt.factorizations() == buffers.factored_number &&
+                           buffers.factored_w == &w && buffers.factored_shift == shift &&
+                           buffers.factored_active == active;
+  if (!same_matrix) {
+    ldlt.factorize(w, active, shift > 0.0 ? 0.0 : kRankTolerance, 0.0, shift);
+    buffers.factored_w = &w;
+    buffers.factored_active = active;
+    buffers.factored_shift = shift;
+    buffers.factored_number = ldlt.factorizations();
+  }
   ldlt.solve(rhs);
   for (Eigen::Index row = 0; row < m; ++row)
     if (active[static_cast<std::size_t>(row)]) d(row) = rhs(row);
@@ -636,6 +656,7 @@ void FrictionalSolver::proximal_newton(const FrictionalProblem& problem, const s
     if (epsilon != shifted_by) {
       shifted = *problem.w;
       shifted.diagonal().array() += epsilon;
+      buffers_->factored_number = 0;  // a factorization of `shifted` is of its old values
       shifted_by = epsilon;
     }
     sub.w = &shifted;
@@ -663,6 +684,7 @@ void FrictionalSolver::solve(const FrictionalProblem& problem, FrictionalStats& 
   FrictionalWorkspace& workspace = problem.workspace != nullptr ? *problem.workspace : own;
   if (!workspace.newton) workspace.newton = std::make_unique<FrictionalWorkspace::Newton>();
   buffers_ = workspace.newton.get();
+  buffers_->factored_number = 0;  // this problem's W may sit where the last one's did
   const Eigen::Index m = problem.q.size();
   ++stats.problems;
   const bool warm = problem.start != nullptr && problem.start->size() == m && problem.start->allFinite();

@@ -44,6 +44,7 @@ void MaskedLdlt::analyze(const Matrix& a, std::span<const char> rows) {
   visited_.assign(n, 0);
   reach_.clear();
   stamp_ = 0;
+  ++factorizations_;  // the factor is gone
 }
 
 // Fill-reducing order of the analysed rows (AMD on their pattern), the others after them.
@@ -257,6 +258,7 @@ bool MaskedLdlt::same_pattern(const Matrix& a) const {
 std::size_t MaskedLdlt::factorize(const Matrix& a, std::span<const char> on, double rank_tolerance, double floor,
                                   double shift) {
   assert(covers(on) && "a row of F outside the analysed pattern would be factorized as if uncoupled");
+  ++factorizations_;
   double work = 0.0;
   std::size_t dropped = 0;
   if (schedule_.empty()) {

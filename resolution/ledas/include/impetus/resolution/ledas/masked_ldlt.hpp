@@ -113,6 +113,9 @@ class MaskedLdlt {
   double pivot_inverse(SparseIndex i) const { return d_inverse_[i]; }
   /// Flops (multiply-adds) of the last factorize(): the cost an update is weighed against.
   double factorization_work() const { return work_; }
+  /// factorize() calls so far (with analyze() calls, which invalidate the factor): a caller that
+  /// remembers the number of its own last factorization knows whether the factor is still that one.
+  std::uint64_t factorizations() const { return factorizations_; }
 
   /// Rows of the last (shifted) factorization whose pivot is at most √(shift·A_kk): the rows (nearly)
   /// dependent on the rows eliminated before them (A_FF is singular if there is one).
@@ -171,6 +174,7 @@ class MaskedLdlt {
   mutable IndexVector<SparseIndex> reach_, visited_;     // forward_sparse: the ancestors, a visit stamp per row
   mutable SparseIndex stamp_ = 0;
   double work_ = 0.0;
+  std::uint64_t factorizations_ = 0;
 };
 
 }  // namespace impetus::ledas
