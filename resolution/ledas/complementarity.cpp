@@ -42,7 +42,8 @@ ComplementaritySolver::ComplementaritySolver(const SolverSettings& settings, Equ
 ComplementaritySolver::~ComplementaritySolver() = default;
 
 std::unique_ptr<MaskedLdlt> ComplementaritySolver::checkout_masked(const SparseMatrix& m, std::span<const char> likely,
-                                                         SolverStats& stats) {
+                                                                   std::span<const std::array<std::int32_t, 2>> groups,
+                                                                   SolverStats& stats) {
   for (auto it = masked_cache_.begin(); it != masked_cache_.end(); ++it) {
     if ((*it)->same_pattern(m)) {
       std::unique_ptr<MaskedLdlt> f = std::move(*it);
@@ -61,7 +62,7 @@ std::unique_ptr<MaskedLdlt> ComplementaritySolver::checkout_masked(const SparseM
   } else {
     f = std::make_unique<MaskedLdlt>();
   }
-  f->analyze(m, likely);
+  f->analyze(m, likely, groups);
   ++stats.symbolic_analyses;
   return f;
 }
@@ -81,7 +82,7 @@ void ComplementaritySolver::factorize_loop(ActiveLoop& loop, const SparseMatrix&
     if (!loop.widened)
       for (std::size_t k = 0; k < rows.size(); ++k) wider[k] = rows[k] || loop.factor->analysed(k);
     loop.widened = true;
-    loop.factor->analyze(a, wider);
+    loop.factor->analyze(a, wider, loop.groups);
     ++stats.symbolic_analyses;
   }
   ++stats.sparse;
@@ -251,7 +252,8 @@ void ComplementaritySolver::solve(const ComplementarityProblem& problem, SolverS
   }
   if (suits_body_space(problem, settings_) && solve_in_body_space(problem, body_space_, stats, p)) return;
   Search search(problem, settings_, scale, *work_);
-  search.loop.factor = checkout_masked(a, search.free_rows, stats);
+  search.loop.groups = problem.groups;
+  search.loop.factor = checkout_masked(a, search.free_rows, problem.groups, stats);
   const std::uint64_t budget = work_budget(m, settings_);
   for (std::uint64_t iteration = 0; iteration < budget && !search.done(); ++iteration)
     iterate(search, iteration, stats);

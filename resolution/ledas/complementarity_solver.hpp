@@ -55,7 +55,8 @@ class ComplementaritySolver {
   /// A masked factorization of m's pattern: the cached one if there is one (analysed for the rows of an
   /// earlier start set: factorize_loop widens it when a free set needs more), else a new analysis for
   /// the rows `likely` to be free (the start set; MaskedLdlt::analyze).
-  std::unique_ptr<MaskedLdlt> checkout_masked(const SparseMatrix& m, std::span<const char> likely, SolverStats& stats);
+  std::unique_ptr<MaskedLdlt> checkout_masked(const SparseMatrix& m, std::span<const char> likely,
+                                              std::span<const std::array<std::int32_t, 2>> groups, SolverStats& stats);
   void checkin_masked(std::unique_ptr<MaskedLdlt> factor);
 
   using Workspace = ComplementarityWorkspace;

@@ -18,6 +18,7 @@ void LedasResolver::velocity_complementary(ledas::Island& island, std::span<Rigi
   problem.matrix = &island.a;
   problem.equality.assign(island.equality.begin(), island.equality.end());
   problem.start.assign(m, 0);
+  problem.groups.assign(island.incidence.slots.begin(), island.incidence.slots.end());
   problem.tolerance = settings_.tolerance;
   problem.body_space = nullptr;
   if (ledas::wants_body_space(island, m, solver_settings_)) {

@@ -37,6 +37,8 @@ void LedasResolver::correct_positions(ledas::Island& island, std::span<RigidBody
   problem.matrix = island.frictional ? &restricted : &island.a;
   problem.equality.assign(m, 0);
   problem.start.assign(m, 0);
+  problem.groups.resize(m);
+  for (std::size_t j = 0; j < m; ++j) problem.groups[j] = island.incidence.slots[local(j)];
   problem.rhs.setZero(static_cast<Eigen::Index>(m));
   problem.tolerance = kPositionTolerance;
   bool needed = false;

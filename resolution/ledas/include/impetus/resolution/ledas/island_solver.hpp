@@ -139,6 +139,9 @@ struct ComplementarityProblem {
   /// A's factored form, optional: with it a large problem with more rows than body coordinates is
   /// solved by an interior point in body space first (SolverSettings::interior_point_rows).
   const BodySpace* body_space = nullptr;
+  /// Per row, optional: the slots of its movable bodies (−1: fixed), whose sharing makes A's pattern;
+  /// the factorization's ordering reads them instead of A (MaskedLdlt::analyze).
+  std::vector<std::array<std::int32_t, 2>> groups = {};
 };
 
 /// Solves island systems exactly: two solvers behind one interface, the equality solver of the paper
