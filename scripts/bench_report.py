@@ -459,8 +459,9 @@ def main():
                 "A running resolver handed a contact pattern it has not seen (the prepared contacts rotated to "
                 "one of 40 start points: the same problem, rows in a new order, more patterns than ledas caches "
                 "analyses of), against the same pattern solved again right after (the warm solve of the rows "
-                "above). The cold solve pays the symbolic analysis (AMD ordering, elimination tree, row patterns "
-                "of L); with friction the interior point's and Newton's shared analysis of W. "
+                "above). The cold solve pays the symbolic analysis (the order: COLAMD on the rows' bodies up to "
+                "2,000 analysed rows, else AMD; the elimination tree; the row patterns of L); with friction the "
+                "interior point's and Newton's shared analysis of W. "
                 "`benchmarks/resolve.cpp`, `resolve_cold`.", "",
                 f"Machine: {machine(cold['context'])}.", "",
                 cold_table(cold["rows"]), ""]
