@@ -137,8 +137,9 @@ void step(benchmark::State& state, const std::string& resolver_name, Scene scene
 // contacts, islands, rounds; residual, natural_map and penetration (deepest contact a detection found)
 // are the largest over the steps, and energy_change the kinetic energy the resolve stage changed per
 // step (J). With friction, ledas's rows also count its frictional stages per step (friction_problems,
-// warm_solved, slips_taken, releases, relaxed, newton_steps, interior_point_steps, proximal_steps,
-// friction_non_converged: ledas::FrictionalStats).
+// warm_solved, slips_taken, releases, relaxed, newton_steps, newton_reused (those of them that reused
+// the step before's factorization), interior_point_steps, proximal_steps, friction_non_converged:
+// ledas::FrictionalStats).
 constexpr int kDynamicSteps = 5;
 
 const bench::DynamicStates& snapshot(const std::string& family, int n, double mu) {
@@ -217,6 +218,7 @@ void dynamic_step(benchmark::State& state, const std::string& resolver_name, con
     state.counters["releases"] = per_step(static_cast<double>(friction.releases));
     state.counters["relaxed"] = per_step(static_cast<double>(friction.relaxed));
     state.counters["newton_steps"] = per_step(static_cast<double>(friction.newton_steps));
+    state.counters["newton_reused"] = per_step(static_cast<double>(friction.newton_reused));
     state.counters["interior_point_steps"] = per_step(static_cast<double>(friction.interior_point_steps));
     state.counters["proximal_steps"] = per_step(static_cast<double>(friction.proximal_steps));
     state.counters["friction_non_converged"] = per_step(static_cast<double>(friction.non_converged));

@@ -93,6 +93,7 @@ struct FrictionalWorkspace::Newton {
   std::vector<char> factored_active;
   double factored_shift = 0.0;
   std::uint64_t factored_number = 0;
+  bool reused = false;  // whether the last direction reused that factorization
   // The cold path's (solve, solve_stages, proximal_newton): kept so that a cold solve of a problem with
   // the last one's pattern allocates nothing either (where no contact slides above `dense_limit`).
   ConeQpWorkspace cone_qp;
@@ -333,6 +334,7 @@ bool symmetric_direction(const std::vector<Block>& blocks, const std::vector<Lin
   const bool same_matrix = buffers.factored_number != 0 && ldlt.factorizations() == buffers.factored_number &&
                            buffers.factored_w == &w && buffers.factored_shift == shift &&
                            buffers.factored_active == active;
+  buffers.reused = same_matrix;
   if (!same_matrix) {
     ldlt.factorize(w, active, shift > 0.0 ? 0.0 : kRankTolerance, 0.0, shift);
     buffers.factored_w = &w;
@@ -370,6 +372,7 @@ bool newton_direction(const std::vector<Block>& blocks, const std::vector<Linear
                       double shift, const Vector& f, std::size_t dense_limit, FrictionalWorkspace::Newton& buffers,
                       Vector& d) {
   const Eigen::Index m = f.size();
+  buffers.reused = false;
   if (static_cast<std::size_t>(m) <= dense_limit) {
     Eigen::MatrixXd& j = buffers.jacobian;
     j.setZero(m, m);
@@ -508,6 +511,7 @@ void add(FrictionalStats& into, const FrictionalStats& part) {
   into.releases += part.releases;
   into.fixed_point_steps += part.fixed_point_steps;
   into.newton_steps += part.newton_steps;
+  into.newton_reused += part.newton_reused;
   into.interior_point_steps += part.interior_point_steps;
   into.proximal += part.proximal;
   into.proximal_steps += part.proximal_steps;
@@ -602,6 +606,7 @@ double FrictionalSolver::newton(const FrictionalProblem& problem, const std::vec
       ++stats.nan_caught;
       break;
     }
+    stats.newton_reused += buffers.reused ? 1 : 0;
     // Armijo on ½‖F‖²: its derivative along the Newton direction is −‖F‖² = −2 merit.
     double step = 1.0, trial_merit = merit;
     bool accepted = false;

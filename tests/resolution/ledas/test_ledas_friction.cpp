@@ -260,6 +260,7 @@ TEST(LedasFriction, KeptSparseAnalysisSolvesProblemsWithNewValues) {
 // tolerance 1e-12 in two: every block is active or open there, so the Alart–Curnier function is linear,
 // and Newton's system is the symmetric one on the active rows (120 rows: the sparse path), which must
 // also carry the open contact's correction across. Impulses to 1e-10 relative, velocities to 1e-10 m/s.
+// The second step's matrix is the first's, so it factorizes nothing.
 TEST(LedasFriction, NewtonSolvesAStickingColumnFromAWrongWarmStartInTwoSteps) {
   constexpr int kSpheres = 40;
   std::vector<RigidBody> bodies{ground_plane()};
@@ -289,6 +290,9 @@ TEST(LedasFriction, NewtonSolvesAStickingColumnFromAWrongWarmStartInTwoSteps) {
   const ledas::Vector r = ledas::FrictionalSolver().solve(problem, stats);
   EXPECT_EQ(stats.warm_started, 1u);
   EXPECT_EQ(stats.newton_steps, 2u);  // the second removes what the Jacobian's shift left (~1e-9)
+  // Both steps stick every contact with the same shift, so the second's matrix is the first's: it reuses
+  // that factorization (the bits a new one would give) instead of computing it again.
+  EXPECT_EQ(stats.newton_reused, 1u);
   EXPECT_LE((r - expected).norm(), 1e-10 * expected.norm());
   const ledas::Vector u = w * r + problem.q;
   for (int c = 0; c + 1 < kSpheres; ++c)

@@ -131,7 +131,8 @@ struct FrictionalStats {
   std::uint64_t slips_taken = 0;       ///< slipping warm answers taken after the loose check (slip_check)
   std::uint64_t releases = 0;          ///< problems solved with one contact released (release_max_contacts)
   std::uint64_t fixed_point_steps = 0; ///< Cadoux's fixed-point steps
-  std::uint64_t newton_steps = 0;      ///< Newton steps (one factorization each)
+  std::uint64_t newton_steps = 0;      ///< Newton steps (one factorization each, but newton_reused)
+  std::uint64_t newton_reused = 0;     ///< Newton steps that reused the step before's factorization (same matrix)
   std::uint64_t interior_point_steps = 0;  ///< interior-point steps on relaxations (one factorization each)
   std::uint64_t proximal = 0;          ///< problems that needed the proximal stage (redundant contacts)
   std::uint64_t proximal_steps = 0;    ///< its proximal points (a Newton solve each)
