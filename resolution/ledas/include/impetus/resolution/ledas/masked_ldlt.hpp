@@ -2,7 +2,7 @@
 /// \file
 /// LDLᵀ of a principal submatrix A_FF of a symmetric positive semi-definite matrix A (the paper's eq. 7
 /// matrix of one island), for a set F of rows that changes from call to call while A's sparsity pattern
-/// does not. Rows outside F are replaced by identity rows, so one symbolic analysis (AMD ordering,
+/// does not. Rows outside F are replaced by identity rows, so one symbolic analysis (fill-reducing order,
 /// elimination tree, column counts) of A's full pattern serves every F of an active-set loop, and every
 /// step while the contact graph is unchanged.
 ///
