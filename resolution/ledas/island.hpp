@@ -59,7 +59,9 @@ struct Island {
   ComplementarityWorkspace impact_work, correction_work;
   Vector impact_target, impact_solution, correction_solution;
   std::vector<RowIndex> kept;  ///< a frictional island's correction rows (all but tangent rows)
-  BodySpace body_space;        ///< A's factored form for a problem that suits the interior point
+  BodySpace body_space;        ///< A's factored form for an impact that suits the interior point
+  BodySpace correction_body_space;  ///< ... for a position correction (solved alongside the impact)
+  bool correction_refused = false;  ///< the correction's solver refused its answer (zero returned)
   SparseMatrix restricted;     ///< and A over them
 
   /// A frictional island's impact (frictional_impact.cpp), in buffers kept the same way: the problem

@@ -15,9 +15,13 @@
 namespace impetus {
 
 struct LedasResolver::Lane {
-  explicit Lane(const ledas::SolverSettings& settings) : solver(settings) {}
+  explicit Lane(const ledas::SolverSettings& settings) : solver(settings), correction_solver(settings) {}
 
+  // The velocity phase's solver and the position correction's, each with its own caches: the two may
+  // solve one island at once (LedasResolver::solve_island), and a correction solved by its own solver is
+  // the same whether it ran alongside the impact or after it.
   ledas::IslandSolver solver;
+  ledas::IslandSolver correction_solver;
   ledas::FrictionalSolver friction;
   LedasStats stats;            // this step's, added into the resolver's in lane order
   ResolverCounters counters;   // likewise

@@ -7,6 +7,8 @@
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
+#include <tbb/parallel_invoke.h>
+#include <tbb/task_arena.h>
 
 #include <algorithm>
 #include <cmath>
@@ -222,10 +224,36 @@ void LedasResolver::build_rows(std::span<const RigidBody> bodies, std::span<Cont
 }
 
 // One island: the velocity phase by mode, its report, then the position correction.
+// An island: its velocity phase (the impact) and its position correction. The two are independent
+// problems on the same A: the correction's targets come from the contacts' depths, not from velocities,
+// and it only moves positions, which the impact does not read. So on an island of at least
+// kConcurrentRows rows, with a second thread in the arena, they are solved at once, each by its own
+// solver; the correction is applied after both. Its result is the same bits either way.
 void LedasResolver::solve_island(std::span<const std::uint32_t> rows, std::span<RigidBody> bodies,
                                  std::span<Contact> contacts, double dt, Lane& lane) {
+  constexpr std::size_t kConcurrentRows = 64;  // below, a correction takes a few µs: too little to share
   ledas::Island& island = lane.next_island();
   make_island(rows, bodies, dt, island);
+  bool corrected = false;
+  const std::span<const RigidBody> seen(bodies);
+  if (rows.size() >= kConcurrentRows && tbb::this_task_arena::max_concurrency() > 1) {
+    tbb::parallel_invoke([&] { velocity_phase(island, bodies, contacts, lane); },
+                         [&] { corrected = solve_correction(island, seen, lane); });
+  } else {
+    velocity_phase(island, bodies, contacts, lane);
+    corrected = solve_correction(island, seen, lane);
+  }
+  if (corrected) apply_correction(island, bodies, lane);
+  ++lane.counters.islands;
+  ++lane.stats.islands;
+  lane.stats.largest_island = std::max(lane.stats.largest_island, island.rows.size());
+  lane.stats.rounds = std::max(lane.stats.rounds, island.rounds);
+  for (BodyIndex body : island.bodies) body_slot_[body] = -1;
+}
+
+// The impact of one island (its mode's velocity phase), its report and its warm starts.
+void LedasResolver::velocity_phase(ledas::Island& island, std::span<RigidBody> bodies, std::span<Contact> contacts,
+                                   Lane& lane) {
   const double energy_before = ledas::kinetic_energy(bodies, island.bodies);
   if (settings_.mode == LedasMode::paper) velocity_paper(island, bodies, lane);
   else if (island.frictional) velocity_frictional(island, bodies, lane);
@@ -236,12 +264,6 @@ void LedasResolver::solve_island(std::span<const std::uint32_t> rows, std::span<
     ++lane.counters.energy_gain_events;
   report_island(island, bodies, contacts, lane.counters);
   if (island.frictional && settings_.warm_start) remember_impulses(lane, island, contacts);
-  correct_positions(island, bodies, lane);
-  ++lane.counters.islands;
-  ++lane.stats.islands;
-  lane.stats.largest_island = std::max(lane.stats.largest_island, island.rows.size());
-  lane.stats.rounds = std::max(lane.stats.rounds, island.rounds);
-  for (BodyIndex body : island.bodies) body_slot_[body] = -1;
 }
 
 // After the velocity phase: each contact's total impulse (normal and tangential) and mode, and the

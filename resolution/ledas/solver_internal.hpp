@@ -25,7 +25,6 @@ struct ComplementaritySolver::ActiveLoop {
   bool factored = false;
   double floor = 0.0;         // A_kk at or below this: nothing movable behind row k
   bool singular = false;      // a factorization met a redundant row (pivot ≈ the shift)
-  bool widened = false;       // the analysis was redone for rows beyond the start set
   std::span<const std::array<std::int32_t, 2>> groups;  // the problem's, for the analysis (may be empty)
   std::vector<char> in_base;  // rows B of the last factorization (free and not dropped)
   BorderedUpdate* update = nullptr;  // solves for active sets near B without refactoring (the workspace's)

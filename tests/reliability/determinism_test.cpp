@@ -206,12 +206,14 @@ TEST(Determinism, GoldenHashPerResolver) {
 // for every thread count. Scenes with many islands and many pairs (several chunks of the narrowphase),
 // with and without friction; 2 and 4 threads on a 2-core machine still interleave the lanes differently.
 // The dropped pyramid of 40 rows is one island large enough for ledas to factorize subtrees of its
-// elimination tree in parallel (masked_ldlt.hpp).
+// elimination tree in parallel (masked_ldlt.hpp), and to solve its impact and its position correction
+// at once (LedasResolver::solve_island); the knocked wall does the same with both problems in body space.
 TEST(Determinism, SameHashForEveryThreadCount) {
   const auto host = make_host();
   const std::pair<const char*, std::vector<SceneOverride>> scenes[] = {
       {"friction_ramp", {}},  {"resting_shapes", {}},      {"billiards", {}},
-      {"demo", {}},           {"friction_card_house", {}}, {"pyramid_drop_10", {{"generators.0.pyramid.rows", "40"}}}};
+      {"demo", {}},           {"friction_card_house", {}}, {"pyramid_drop_10", {{"generators.0.pyramid.rows", "40"}}},
+      {"knocked_wall", {}}};
   for (const auto& [scene, extra] : scenes) {
     std::uint64_t first = 0;
     for (const char* threads : {"1", "2", "4"}) {

@@ -142,6 +142,9 @@ struct ComplementarityProblem {
   /// Per row, optional: the slots of its movable bodies (−1: fixed), whose sharing makes A's pattern;
   /// the factorization's ordering reads them instead of A (MaskedLdlt::analyze).
   std::vector<std::array<std::int32_t, 2>> groups = {};
+  /// Analyse every row at once rather than the start set's (MaskedLdlt::analyze): for a problem whose
+  /// free set usually grows to most rows (the position correction), one ordering instead of two.
+  bool analyse_every_row = false;
 };
 
 /// Solves island systems exactly: two solvers behind one interface, the equality solver of the paper

@@ -148,7 +148,9 @@ class LedasResolver final : public CollisionResolver {
                     std::span<RigidBody> bodies);
   void report_island(ledas::Island& island, std::span<const RigidBody> bodies, std::span<Contact> contacts,
                      ResolverCounters& counters);
-  void correct_positions(ledas::Island& island, std::span<RigidBody> bodies, Lane& lane);
+  bool solve_correction(ledas::Island& island, std::span<const RigidBody> bodies, Lane& lane);
+  void apply_correction(ledas::Island& island, std::span<RigidBody> bodies, Lane& lane);
+  void velocity_phase(ledas::Island& island, std::span<RigidBody> bodies, std::span<Contact> contacts, Lane& lane);
   Lane& lane(std::size_t index);
 
   LedasSettings settings_;
