@@ -156,6 +156,8 @@ class LedasResolver final : public CollisionResolver {
   LedasSettings settings_;
   ledas::SolverSettings solver_settings_;     // the lanes' island solvers'
   std::vector<std::unique_ptr<Lane>> lanes_;  // created when first used
+  std::vector<std::size_t> lane_order_;        // this step's lanes, heaviest first (resolve_all)
+  std::vector<double> lane_load_;
   ledas::FrictionalSolver friction_solver_;   // solve_contact_problem's
   LedasStats stats_;
   std::vector<resolution::ImpulseRow> rows_;  // this step's rows: contacts first, then joint rows
