@@ -317,7 +317,8 @@ void register_all() {
       const char* family;
       int n;
       const char* mu;
-    } dynamic[] = {{"heap", 1000, ""},   {"heap", 10000, ""},         {"pile", 1000, ""},
+    } dynamic[] = {{"heap", 300, ""},    {"heap", 1000, ""},          {"heap", 3000, ""},
+                   {"heap", 10000, ""},  {"pile", 1000, ""},
                    {"knocked_wall", 200, ""}, {"heap", 1000, "0.5"}, {"pile", 1000, "0.5"},
                    {"pyramid", 100, ""}};
     for (const auto& scene : dynamic) {
