@@ -430,10 +430,15 @@ def heap_chart(series, out_dir):
     ax.set_title("Heap of spheres settling: whole-step time against bodies")
     ax.grid(True, which="both", alpha=0.3)
     ax.legend(fontsize=8)
+    return save_figure(plt, fig, out_dir, "dynamic_heap")
+
+
+def save_figure(plt, fig, out_dir, name):
+    """Writes the figure as out_dir/name.{png,svg}, closes it, returns the paths."""
     fig.tight_layout()
     written = []
     for ext in ("png", "svg"):
-        path = os.path.join(out_dir, f"dynamic_heap.{ext}")
+        path = os.path.join(out_dir, f"{name}.{ext}")
         fig.savefig(path, dpi=110)
         written.append(path)
     plt.close(fig)
@@ -449,7 +454,6 @@ def charts(res, out_dir):
         print("bench_report: matplotlib not installed (apt-get install python3-matplotlib): charts skipped")
         return []
     os.makedirs(out_dir, exist_ok=True)
-    written = []
     fig, axes = plt.subplots(1, 2, figsize=(12, 5))
     markers = {"ledas": "o", "ledas_paper": "s", "mirtich": "^"}
     for ax, family in zip(axes, ["pyramid", "line"]):
@@ -475,14 +479,7 @@ def charts(res, out_dir):
         ax.set_title(f"{family}: resolver alone, e = 0" + (" (sphere pyramid drop)" if family == "pyramid" else " (line push)"))
         ax.grid(True, which="both", alpha=0.3)
         ax.legend(fontsize=8)
-    fig.tight_layout()
-    for ext in ("png", "svg"):
-        path = os.path.join(out_dir, f"scaling.{ext}")
-        fig.savefig(path, dpi=110)
-        written.append(path)
-    plt.close(fig)
-
-    return written
+    return save_figure(plt, fig, out_dir, "scaling")
 
 
 def main():
