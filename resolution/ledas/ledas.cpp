@@ -239,7 +239,6 @@ void LedasResolver::build_rows(std::span<const RigidBody> bodies, std::span<Cont
   row_warm_.resize(rows_.size(), 0.0);
 }
 
-// One island: the velocity phase by mode, its report, then the position correction.
 // An island: its velocity phase (the impact) and its position correction. The two are independent
 // problems on the same A: the correction's targets come from the contacts' depths, not from velocities,
 // and it only moves positions, which the impact does not read. So on an island of at least
