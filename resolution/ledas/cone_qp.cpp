@@ -215,7 +215,7 @@ void solve_cone_qp(const FrictionalProblem& problem, double target, std::uint64_
   const double c_scale = std::max(c.lpNorm<Eigen::Infinity>(), std::numeric_limits<double>::min());
 
   // Start at the cones' centres e = (1, 0, 0), sized to the problem: x ~ impulses, z ~ velocities.
-  Vector &x = ws.x, &z = ws.z, &r = ws.r, &best = ws.best, &rd = ws.rd;
+  Vector &x = ws.x, &z = ws.z, &r = ws.r, &best = ws.best, &rd = ws.rd, &u = ws.u;
   x.setZero(m);
   z.setZero(m);
   for (const Cone& k : cones)
@@ -233,7 +233,9 @@ void solve_cone_qp(const FrictionalProblem& problem, double target, std::uint64_
 
   for (; report.iterations < max_iterations; ++report.iterations) {
     r = x.cwiseQuotient(d);
-    const double residual = natural_map_residual(problem, r);
+    rd.noalias() = w.transpose() * r;  // = W r (symmetric), as a gather
+    u = rd + problem.q;
+    const double residual = natural_map_residual(problem, r, u);
     if (residual < best_residual) {
       best_residual = residual;
       best = r;
@@ -242,8 +244,7 @@ void solve_cone_qp(const FrictionalProblem& problem, double target, std::uint64_
       report.converged = true;
       break;
     }
-    rd.noalias() = w * r;  // the dual residual P x + c − z (z = 0 on joint rows)
-    rd = rd.cwiseQuotient(d) + c - z;
+    rd = rd.cwiseQuotient(d) + c - z;  // the dual residual P x + c − z (z = 0 on joint rows)
     double gap = 0.0;
     for (const Cone& k : cones)
       if (!k.free) gap += block(x, k).dot(block(z, k));

@@ -47,7 +47,7 @@ struct ConeQpWorkspace {
   SparseMatrix h;
   std::vector<SparseIndex> from_w, block, outer, inner;
   std::vector<char> every_row;
-  Vector d, c, x, z, r, best, rd, dx_aff, dz_aff, dx, dz;
+  Vector d, c, x, z, r, best, rd, u, dx_aff, dz_aff, dx, dz;  // u = W r + q of the iterate r
 };
 
 /// Into r (size m): the relaxation's impulses, the iterate with the smallest natural-map residual of the

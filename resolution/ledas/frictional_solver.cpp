@@ -536,12 +536,7 @@ void project_on_cone(double mu, double& yn, double& yt1, double& yt2) {
   yt2 *= scale;
 }
 
-namespace {
-
-// natural_map_residual with u = W r + q computed into `u`.
-double natural_map_residual_in(const FrictionalProblem& problem, const Vector& r, Vector& u) {
-  u.noalias() = problem.w->transpose() * r;  // = W r (symmetric), as a gather
-  u += problem.q;
+double natural_map_residual(const FrictionalProblem& problem, const Vector& r, const Vector& u) {
   double sum = 0.0;
   const auto m = r.size();
   for (Eigen::Index i = 0; i < m;) {
@@ -570,6 +565,15 @@ double natural_map_residual_in(const FrictionalProblem& problem, const Vector& r
   return std::sqrt(sum);
 }
 
+namespace {
+
+// natural_map_residual with u = W r + q computed into `u` (as every caller computes it: its bits).
+double natural_map_residual_in(const FrictionalProblem& problem, const Vector& r, Vector& u) {
+  u.noalias() = problem.w->transpose() * r;  // = W r (symmetric), as a gather
+  u += problem.q;
+  return natural_map_residual(problem, r, u);
+}
+
 }  // namespace
 
 double natural_map_residual(const FrictionalProblem& problem, const Vector& r) {
@@ -590,9 +594,7 @@ double FrictionalSolver::newton(const FrictionalProblem& problem, const std::vec
          &f_trial = buffers.f_trial, &d = buffers.d;
   std::vector<Linearization>&lin = buffers.lin, &lin_trial = buffers.lin_trial;
   best = r;
-  double best_residual = natural_map_residual(problem, r);
-  u.noalias() = w.transpose() * r;  // = W r (symmetric), as a gather
-  u += problem.q;
+  double best_residual = natural_map_residual_in(problem, r, u);  // and u = W r + q
   f.resize(m);
   trial.resize(m);
   u_trial.resize(m);
@@ -627,7 +629,8 @@ double FrictionalSolver::newton(const FrictionalProblem& problem, const std::vec
     f.swap(f_trial);
     lin.swap(lin_trial);
     merit = trial_merit;
-    if (const double residual = natural_map_residual(problem, r); residual < best_residual) {
+    // u is W r + q already (the trial's, computed as natural_map_residual computes it).
+    if (const double residual = natural_map_residual(problem, r, u); residual < best_residual) {
       best_residual = residual;
       best = r;
     }

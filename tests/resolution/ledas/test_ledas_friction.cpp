@@ -489,6 +489,12 @@ TEST(LedasFriction, ReleasingOneContactSolvesWhereEveryStageStalls) {
     EXPECT_GT(r(3 * c), 0.0);
     EXPECT_NEAR(r.segment(3 * c + 1, 2).norm(), 0.5 * r(3 * c), 1e-9);
   }
+  // The residual from velocities a caller already has (Newton's accepted trial, the interior point's
+  // W r) is the residual, bit for bit, on the solution and on the stalled iterate alike.
+  for (const ledas::Vector* iterate : {&r, &stuck}) {
+    const ledas::Vector velocities = w.transpose() * *iterate + problem.q;
+    EXPECT_EQ(ledas::natural_map_residual(problem, *iterate, velocities), ledas::natural_map_residual(problem, *iterate));
+  }
 }
 
 // The proximal stage solves the problem it is given: on the relaxation, its subproblems are relaxations

@@ -150,6 +150,8 @@ void add(FrictionalStats& into, const FrictionalStats& part);
 /// r − P_K(r − (u + μ‖u_t‖ e_n)) for frictional contacts, r − max(0, r − u) for frictionless ones and u
 /// for joint rows, with u = W r + q.
 double natural_map_residual(const FrictionalProblem& problem, const Vector& r);
+/// The same, with r's velocities u = W r + q given (a caller that has them saves the product with W).
+double natural_map_residual(const FrictionalProblem& problem, const Vector& r, const Vector& u);
 
 /// Projects y = (y_n, y_t1, y_t2) on the cone ‖y_t‖ ≤ μ y_n (in place).
 void project_on_cone(double mu, double& yn, double& yt1, double& yt2);
