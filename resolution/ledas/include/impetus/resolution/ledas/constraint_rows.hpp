@@ -22,6 +22,7 @@
 #include "impetus/modules/constraint.hpp"
 #include "impetus/resolution/common/impulse_rows.hpp"
 
+#include <cstddef>
 #include <cstdint>
 #include <span>
 #include <string>
@@ -45,6 +46,9 @@ struct RowInfo {
 /// A position-level joint row's separation s⁺ (m, along the row) after a step of `dt` at the bodies'
 /// current velocities, the bodies moved as eq. 2 moves them (x += dt v, R = Q(ω dt) R).
 double predicted_separation(const resolution::ImpulseRow& row, std::span<const RigidBody> bodies, double dt);
+
+/// The most rows append_constraint_rows() adds for one constraint (point-point 3, coaxial 4).
+inline constexpr std::size_t kMaxConstraintRows = 4;
 
 /// Appends the rows of `constraint` at the bodies' current poses for a step of `dt` (s), the bodies' J⁻¹
 /// from `inertia` (reset for `bodies`):
