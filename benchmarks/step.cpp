@@ -138,7 +138,7 @@ void step(benchmark::State& state, const std::string& resolver_name, Scene scene
 // are the largest over the steps, and energy_change the kinetic energy the resolve stage changed per
 // step (J). With friction, ledas's rows also count its frictional stages per step (friction_problems,
 // warm_solved, slips_taken, releases, relaxed, newton_steps, newton_reused (those of them that reused
-// the step before's factorization), interior_point_steps, proximal_steps, friction_non_converged:
+// the step before's factorization), interior_point_steps, proximal_steps, nonsmooth_sweeps, nonsmooth_solved, friction_non_converged:
 // ledas::FrictionalStats).
 constexpr int kDynamicSteps = 5;
 
@@ -221,6 +221,8 @@ void dynamic_step(benchmark::State& state, const std::string& resolver_name, con
     state.counters["newton_reused"] = per_step(static_cast<double>(friction.newton_reused));
     state.counters["interior_point_steps"] = per_step(static_cast<double>(friction.interior_point_steps));
     state.counters["proximal_steps"] = per_step(static_cast<double>(friction.proximal_steps));
+    state.counters["nonsmooth_sweeps"] = per_step(static_cast<double>(friction.nonsmooth_sweeps));
+    state.counters["nonsmooth_solved"] = per_step(static_cast<double>(friction.nonsmooth_solved));
     state.counters["friction_non_converged"] = per_step(static_cast<double>(friction.non_converged));
   }
 }

@@ -6,6 +6,7 @@
 #include "impetus/engine/world.hpp"
 #include "impetus/fclib/fclib.hpp"
 #include "impetus/plugins/host.hpp"
+#include "impetus/resolution/ledas/frictional_solver.hpp"
 
 #include <gtest/gtest.h>
 
@@ -402,6 +403,55 @@ TEST(FclibFiles, ResolversWithoutALocalSolverRefuseAProblem) {
   const ModuleStatus status = mirtich->solve_contact_problem(p.view(1e-10), solution);
   EXPECT_FALSE(status.ok);
   EXPECT_NE(status.message.find("does not solve contact problems"), std::string::npos) << status.message;
+}
+
+
+// The dropped sphere pyramid K = 10 at μ = 0.7 with its contact 36 left out (bench_fclib's
+// pyramid_drop_10_mu0.7_without_36): the relaxation's answer slips, and Newton from it, Cadoux's step,
+// the proximal points and their projected sweeps all stall near 2e-2. Nonsmooth Gauss–Seidel sweeps from
+// r = 0 (each contact's own problem solved exactly) reach a Coulomb solution, checked contact by contact
+// against Coulomb's law itself: pressed contacts do not approach, every impulse lies in its cone, and a
+// slipping contact's friction is μ r_n against its slip.
+TEST(Fclib, NonsmoothGaussSeidelSolvesWhereTheNewtonStagesStall) {
+  PluginHost host;
+  const Case c{"pyramid_drop_10.yaml", {"generators.0.pyramid.friction=0.7"}, nullptr};
+  std::unique_ptr<World> world = make_world(c, host);
+  world->detect_contacts();
+  std::vector<Contact> contacts = world->contacts();
+  ASSERT_EQ(contacts.size(), 145u);
+  contacts.erase(contacts.begin() + 36);
+  const fclib::LocalProblem problem = fclib::scene_problem(world->bodies(), contacts, world->settings().dt).local;
+  const double tolerance = 1e-10 * problem.q.norm();
+  std::vector<double> r(problem.rows()), u(problem.rows());
+  LocalContactSolution solution{r.data(), u.data()};
+
+  ledas::FrictionalSettings without;
+  without.nonsmooth_sweeps = 0;
+  ledas::FrictionalSolver stalled(without), solver;
+  ledas::FrictionalStats stalled_stats, stats;
+  ledas::solve_local_problem(stalled, problem.view(tolerance), solution, stalled_stats);
+  EXPECT_FALSE(solution.converged);
+  EXPECT_GT(solution.residual, 1e-4);
+
+  ledas::solve_local_problem(solver, problem.view(tolerance), solution, stats);
+  EXPECT_TRUE(solution.converged);
+  EXPECT_EQ(stats.nonsmooth_solved, 1u);
+  EXPECT_GT(stats.nonsmooth_sweeps, 0u);
+  EXPECT_LE(fclib::natural_map_residual(problem, Eigen::Map<const Eigen::VectorXd>(r.data(), problem.rows())), tolerance);
+  int sliding = 0;
+  for (std::size_t k = 0; k < problem.contacts(); ++k) {
+    const Eigen::Vector3d rk(r[3 * k], r[3 * k + 1], r[3 * k + 2]), uk(u[3 * k], u[3 * k + 1], u[3 * k + 2]);
+    const double mu = problem.mu[k], slip = uk.tail<2>().norm();
+    EXPECT_GE(rk(0), -tolerance) << k;
+    EXPECT_GE(uk(0), -tolerance) << k;
+    EXPECT_LE(rk.tail<2>().norm(), mu * rk(0) + tolerance) << k;
+    if (rk(0) > 1e-6 && slip > 1e-6) {  // sliding: friction at the cone's edge, against the slip
+      ++sliding;
+      EXPECT_NEAR(rk.tail<2>().norm(), mu * rk(0), 1e-8) << k;
+      EXPECT_LT(rk.tail<2>().dot(uk.tail<2>()), 0.0) << k;
+    }
+  }
+  EXPECT_GT(sliding, 0);  // no static equilibrium: some pressed contact slips
 }
 
 }  // namespace

@@ -20,7 +20,9 @@
 ///     answer has no pressed contact slipping it is Coulomb's answer;
 ///  2. else Newton on Coulomb's problem from it, one step of Cadoux's fixed point (the relaxation with q_n
 ///     raised by μ‖u_t‖), and the stages below;
-///  3. a cold answer within the tolerance gets a few Newton steps past it (exact to rounding). The Newton
+///  3. still unsolved: nonsmooth Gauss–Seidel sweeps from r = 0 (each contact's own problem solved
+///     exactly in turn), then Newton from their iterate;
+///  4. a cold answer within the tolerance gets a few Newton steps past it (exact to rounding). The Newton
 ///     stages: a semismooth Newton method on the Alart–Curnier function
 ///   F_n = r_n − max(0, z_n),  z_n = r_n − ρ_n u_n,
 ///   F_t = r_t − P_D(μ max(0, z_n)) (z_t),  z_t = r_t − ρ_t u_t,  P_D(R) the projection on the disk ‖·‖ ≤ R,
@@ -106,6 +108,10 @@ struct FrictionalSettings {
   /// equilibrium exists), and if so take the answer without solving the relaxation to the tolerance.
   bool slip_check = true;
   std::uint64_t refinement_steps = 3;           ///< Newton steps past the tolerance on a cold answer
+  /// Where Newton from the relaxation's answer and Cadoux's step leave Coulomb's problem unsolved:
+  /// nonsmooth Gauss–Seidel sweeps (each contact's own problem solved exactly in turn) from r = 0 at
+  /// most, ended early when 512 sweeps do not halve the residual; then Newton from their iterate. 0: none.
+  std::uint64_t nonsmooth_sweeps = 4096;
   /// A problem of at most this many contacts that the stages leave unsolved is tried with one contact
   /// released: a pressed contact that separates at the best iterate (r_n > 0, u_n > 0) may belong open,
   /// where Newton, having pressed every contact, stalls (a box's four points on the ground, one of them
@@ -136,6 +142,8 @@ struct FrictionalStats {
   std::uint64_t interior_point_steps = 0;  ///< interior-point steps on relaxations (one factorization each)
   std::uint64_t proximal = 0;          ///< problems that needed the proximal stage (redundant contacts)
   std::uint64_t proximal_steps = 0;    ///< its proximal points (a Newton solve each)
+  std::uint64_t nonsmooth_sweeps = 0;  ///< nonsmooth Gauss–Seidel sweeps (FrictionalSettings::nonsmooth_sweeps)
+  std::uint64_t nonsmooth_solved = 0;  ///< problems those sweeps (and Newton from them) solved
   std::uint64_t fallbacks = 0;         ///< problems where the projected Gauss–Seidel fallback ran
   std::uint64_t fallback_sweeps = 0;   ///< its sweeps
   std::uint64_t non_converged = 0;     ///< problems left above the tolerance (best iterate returned)
@@ -173,11 +181,14 @@ class FrictionalSolver {
   struct Block;  // one contact's rows (frictional_solver.cpp)
 
  private:
-  double solve_stages(const FrictionalProblem& problem, Vector& r, bool warm, FrictionalStats& stats);
+  double solve_stages(const FrictionalProblem& problem, Vector& r, bool warm, FrictionalStats& stats,
+                      std::uint64_t budget);
   double newton(const FrictionalProblem& problem, const std::vector<Block>& blocks, Vector& r,
                 std::uint64_t iterations, FrictionalStats& stats);
   void proximal_newton(const FrictionalProblem& problem, const std::vector<Block>& blocks, Vector& r,
                        FrictionalStats& stats);
+  double nonsmooth_gauss_seidel(const FrictionalProblem& problem, const std::vector<Block>& blocks, Vector& r,
+                                FrictionalStats& stats);
   double release_one_contact(const FrictionalProblem& problem, const std::vector<Block>& blocks, Vector& r,
                              FrictionalStats& stats);
 
