@@ -14,6 +14,7 @@
 #include <algorithm>
 #include <cassert>
 #include <cmath>
+#include <limits>
 #include <stdexcept>
 
 namespace impetus::ledas {
@@ -46,6 +47,9 @@ constexpr std::uint64_t kSweepStall = 128;
 // there, the sweeps only linearly), or when it stalls, with this many Newton steps at most.
 constexpr double kSweepHandoff = 1e4;
 constexpr std::uint64_t kSweepNewtonSteps = 30;
+// Cadoux's fixed point (FrictionalSolver::solve, 2 and 4) stops when this many steps have not halved the
+// best residual of its iterates, or when twice as many have not brought it below the best before it.
+constexpr std::uint64_t kFixedPointStall = 3;
 // The check of a slipping warm answer (FrictionalSettings::slip_check): the interior point's target, ×
 // the tolerance, and how far above that target Coulomb's residual of its iterate must lie to show that
 // no static equilibrium exists (10⁷ × the tolerance: 1e-3 ‖q‖).
@@ -115,6 +119,7 @@ struct FrictionalWorkspace::Newton {
   // The nonsmooth Gauss–Seidel stage's: each block's own 3 × 3 block of W, its iterate and velocities.
   std::vector<Eigen::Matrix3d> block_w;
   Vector sweep_r, sweep_u, sweep_best;
+  Vector relaxation_answer;  // Cadoux's fixed point: the last relaxation's answer
 };
 
 FrictionalWorkspace::FrictionalWorkspace() = default;
@@ -868,47 +873,77 @@ void FrictionalSolver::solve(const FrictionalProblem& problem, FrictionalStats& 
     // 2. Where a pressed contact slips, the relaxation separates it at μ‖u_t‖ instead. Newton on
     //    Coulomb's problem from its answer (fast near a solution), then Cadoux's fixed point: the
     //    relaxation again with q_n raised by s = μ‖u_t‖ of the last answer (a fixed point is a Coulomb
-    //    solution), each answer again a start for Newton. On the collapsing sphere pyramid further
-    //    fixed-point steps oscillated (damped too), so by default one is taken.
+    //    solution), each answer again a start for Newton. One step here; more only after the stages (3)
+    //    fail, since on most problems the stages finish sooner, and on the collapsing sphere pyramid the
+    //    steps oscillate.
     buffers.diagonal = problem.w->diagonal();
     make_blocks(problem, buffers.diagonal, buffers.blocks);
     const std::vector<Block>& blocks = buffers.blocks;
     Vector &best = buffers.cold_best, &polished = buffers.polished, &u = buffers.velocity;
     best = r;
     double best_residual = residual;
-    for (std::uint64_t k = 0; k < settings_.fixed_point_iterations && best_residual > problem.tolerance &&
-                              relaxed_residual <= relaxed.tolerance;
-         ++k) {
-      ++stats.fixed_point_steps;
-      steps_left_ = settings_.polish_newton_iterations;
-      polished = r;
-      if (const double now = newton(problem, blocks, polished, settings_.polish_newton_iterations, stats);
-          now < best_residual) {
-        best_residual = now;
-        best = polished;
+    // At most `steps` fixed-point steps from the relaxation's answer `from` (which becomes the last one),
+    // improving `best`; they end when kFixedPointStall steps have not halved the best residual of their
+    // own iterates, or 2 kFixedPointStall steps have not beaten the best before them (`entry`). Returns
+    // whether more steps may follow (none failed, solved the problem or stalled).
+    const auto fixed_point = [&](Vector& from, std::uint64_t steps) {
+      double own = std::numeric_limits<double>::infinity(), mark = own;  // their best, now and kFixedPointStall steps ago
+      const double entry = best_residual;
+      for (std::uint64_t k = 0; k < steps; ++k) {
+        if (k > 0 && k % kFixedPointStall == 0) {
+          if (own > 0.5 * mark || (k >= 2 * kFixedPointStall && own > entry)) return false;
+          mark = own;
+        }
+        ++stats.fixed_point_steps;
+        steps_left_ = settings_.polish_newton_iterations;
+        polished = from;
+        const double now = newton(problem, blocks, polished, settings_.polish_newton_iterations, stats);
+        own = std::min(own, now);
+        if (now < best_residual) {
+          best_residual = now;
+          best = polished;
+        }
+        if (best_residual <= problem.tolerance) return false;
+        u.noalias() = problem.w->transpose() * from;  // = W r (symmetric), as a gather
+        u += problem.q;
+        relaxed.q = problem.q;
+        for (const Block& block : blocks)
+          if (block.size == 3) relaxed.q(block.first) += block.mu * std::hypot(u(block.first + 1), u(block.first + 2));
+        if (solve_stages(relaxed, from, false, stats, settings_.max_newton_steps) > relaxed.tolerance) return false;
+        const double relaxed_now = natural_map_residual(problem, from);
+        own = std::min(own, relaxed_now);
+        if (relaxed_now < best_residual) {
+          best_residual = relaxed_now;
+          best = from;
+        }
       }
-      if (best_residual <= problem.tolerance) break;
-      u.noalias() = problem.w->transpose() * r;  // = W r (symmetric), as a gather
-      u += problem.q;
-      relaxed.q = problem.q;
-      for (const Block& block : blocks)
-        if (block.size == 3) relaxed.q(block.first) += block.mu * std::hypot(u(block.first + 1), u(block.first + 2));
-      if (solve_stages(relaxed, r, false, stats, settings_.max_newton_steps) > relaxed.tolerance) break;
-      if (const double now = natural_map_residual(problem, r); now < best_residual) {
-        best_residual = now;
-        best = r;
-      }
-    }
+      return true;
+    };
+    Vector& relaxation = buffers.relaxation_answer;
+    relaxation = r;
+    const bool more = best_residual > problem.tolerance && relaxed_residual <= relaxed.tolerance &&
+                      settings_.fixed_point_iterations > 0 && fixed_point(relaxation, 1);
     r = best;
     residual = best_residual;
     // 3. Still not solved: the stages on Coulomb's problem from the best answer.
     if (residual > problem.tolerance) residual = solve_stages(problem, r, true, stats, settings_.max_newton_steps);
-    // 4. Still not solved: nonsmooth Gauss–Seidel sweeps from r = 0, then Newton from their iterate, whose
-    //    answer is taken where it solves the problem or improves on the best.
-    if (residual > problem.tolerance && settings_.nonsmooth_sweeps > 0) {
+    // 4. Still not solved, on a problem of at most `last_stages_rows` rows: Cadoux's fixed point goes on
+    //    from the relaxation's last answer. Of 135 island problems of the frictional pile that the stages
+    //    left unsolved (dumped from a run), it solves 114.
+    const bool small = static_cast<std::size_t>(problem.q.size()) <= settings_.last_stages_rows;
+    if (residual > problem.tolerance && more && small) {
+      best = r;
+      best_residual = residual;
+      fixed_point(relaxation, settings_.fixed_point_iterations - 1);
+      r = best;
+      residual = best_residual;
+    }
+    // 5. Still not solved (and as small): nonsmooth Gauss–Seidel sweeps from r = 0, then Newton from their
+    //    iterate, whose answer is taken where it solves the problem or improves on the best.
+    if (residual > problem.tolerance && settings_.nonsmooth_sweeps > 0 && small) {
       Vector& swept = buffers.sweep_r;
       swept.setZero(problem.q.size());
-      double now = nonsmooth_gauss_seidel(problem, blocks, swept, stats);
+      double now = nonsmooth_gauss_seidel(problem, blocks, swept, residual, stats);
       if (now > problem.tolerance) {
         steps_left_ = kSweepNewtonSteps;
         now = newton(problem, blocks, swept, kSweepNewtonSteps, stats);
@@ -919,7 +954,7 @@ void FrictionalSolver::solve(const FrictionalProblem& problem, FrictionalStats& 
         residual = now;
       }
     }
-    // 5. A few more Newton steps. Near a solution they converge quadratically, so the answer is exact to
+    // 6. A few more Newton steps. Near a solution they converge quadratically, so the answer is exact to
     //    rounding, not just to the tolerance, and does not depend on which stage found it (a slope turned
     //    about its normal gives the same slip to 1e-12; the interior point's answer on the pyramid of
     //    K = 50 at rest goes from 1.4e-10 to 5e-13).
@@ -930,7 +965,7 @@ void FrictionalSolver::solve(const FrictionalProblem& problem, FrictionalStats& 
       steps_left_ = settings_.refinement_steps;
       residual = newton(exact, blocks, r, settings_.refinement_steps, stats);
     }
-    // 6. Still not solved, on a small problem: one pressed contact released (release_one_contact).
+    // 7. Still not solved, on a small problem: one pressed contact released (release_one_contact).
     if (residual > problem.tolerance && blocks.size() <= settings_.release_max_contacts)
       residual = release_one_contact(problem, blocks, r, stats);
   }
@@ -945,10 +980,11 @@ void FrictionalSolver::solve(const FrictionalProblem& problem, FrictionalStats& 
 // dropped at μ = 0.5, or with one contact left out at μ = 0.7, it reaches 1e-14 in 2,000–4,000 sweeps
 // where the Newton stages stall at 1e-2. The residual is checked every kSweepCheck sweeps (u recomputed
 // there, so rounding does not accumulate); the stage ends at the tolerance, after
-// `nonsmooth_sweeps`, or when kSweepStall sweeps have not halved the best residual. r becomes the best
-// iterate; returns its residual.
+// `nonsmooth_sweeps`, when kSweepStall sweeps have not halved the best residual, or when 2 kSweepStall
+// sweeps have not brought it below `entry` (the best residual the stages before reached). r becomes the
+// best iterate; returns its residual.
 double FrictionalSolver::nonsmooth_gauss_seidel(const FrictionalProblem& problem, const std::vector<Block>& blocks,
-                                                Vector& r, FrictionalStats& stats) {
+                                                Vector& r, double entry, FrictionalStats& stats) {
   const SparseMatrix& w = *problem.w;
   FrictionalWorkspace::Newton& buffers = *buffers_;
   std::vector<Eigen::Matrix3d>& block_w = buffers.block_w;
@@ -997,7 +1033,7 @@ double FrictionalSolver::nonsmooth_gauss_seidel(const FrictionalProblem& problem
     }
     since_mark += kSweepCheck;
     if (since_mark >= kSweepStall) {
-      if (best_residual > 0.5 * mark) break;
+      if (best_residual > 0.5 * mark || (sweep >= 2 * kSweepStall && best_residual > entry)) break;
       mark = best_residual;
       since_mark = 0;
     }

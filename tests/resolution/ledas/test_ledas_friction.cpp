@@ -497,6 +497,87 @@ TEST(LedasFriction, ReleasingOneContactSolvesWhereEveryStageStalls) {
   }
 }
 
+// An island of the frictional 1,000-primitive pile (dumped from a run, values to the bit): a box on four
+// corners and a fifth contact sliding at 0.6 m/s on it, 15 rows on 12 degrees of freedom, the box's
+// contacts on the edge between sticking and slipping. Newton from the relaxation, one step of Cadoux's
+// fixed point and the proximal stages stall at 20 times the tolerance; Cadoux's fixed point carried on
+// (FrictionalSolver::solve, stage 4) solves it, and the answer obeys Coulomb's law contact by contact.
+TEST(LedasFriction, CadouxFixedPointSolvesWhereTheStagesStall) {
+  const double lower[] = {
+      1.5459288839486223, -0.46288894150724758, 1.9592216012218269, -0.088499883253268186, -0.25505376286274989,
+      2.35590355906186, 0.65396634562904321, -0.71358852227882097, -0.56848308905250056, 1.8248819179319613,
+      0.47173400826690848, -0.033838621535441926, -0.076796686715975102, 0.55953600733378983, 0.59207850006791474,
+      -0.026973292680672556, -0.21103112846078836, 0.78857012279016425, -0.24442968187696326, 0.15124705471695507,
+      1.5817870242775434, -0.40238158767805887, 0.22331486106818074, -0.45998168637436671, 0.22488211919809503,
+      -0.16254315673333602, -0.58835658467805785, 1.8248818880427631, 0.64410377062631163, -0.24971219283265361,
+      0.42903452061888592, 0.55942283409172078, 0.72770430096677341, 0.82608217479996671, -0.16242998290067329,
+      1.3373606305517527, -0.38855955193171576, 0.24181464617542042, -0.27253029042327154, -0.24419223958005104,
+      -0.13326007542828788, 0.16616100313180204, -0.58859402821387896, -0.45281593292451899, 0.83650488572140769,
+      -0.20046496143849768, -0.10006851722221924, 0.71851998875787082, 0.44102622350868831, 0.16232549613832831,
+      0.58881319653650133, -1.1589735751957246, 0.16221232230322852, 0.58905064007743546, 1.8263994272617619,
+      0.20009937459025406, 0.30616478593308954, -0.87236393549180702, 0.55902416075500039, 0.37842706149399247,
+      -0.91042044376088416, -0.16252077090462397, -0.23174005585455953, 0.36954919322129937, 0.16230337867121913,
+      1.3381330371189222, -0.15607368625880352, -0.049229353899875546, 0.40873375992021949, -0.24404360878258893,
+      0.049579330223640611, 1.0753061064260525, -0.5877158406581855, 0.3688917039083921, 0.40547300355108618,
+      0.58817188952036858, -0.4527437793447992, 0.83546757323731868, -1.2568128947455999, 0.83683486612478253,
+      0.82702139143600473, -1.158973575225178, -0.55975366792879766, 0.24488629373540682, 0.44102619364894363,
+      -0.55964049468916544, 0.24464885144360757, 0.22639962855734952, -0.55924155298840539, 0.24449965764477211,
+      1.8263993974314712, 0.37246913694965711, 0.090291214635877859, -0.36653272815694604, 0.55891098751293111,
+      0.51405286239285108, -0.23558532367787249, -0.16240759707196123, 0.3779162737304198, 0.049993335725068221,
+      0.16219020483611929, 0.72796591977037028, -0.13343140566004777, -0.55912837974877305, 0.59182933110793901,
+      -0.51765994550984673, 0.40361642073633319, -0.6523666532932163, -0.24380616648567666, -0.23492779992160234,
+      -0.34031991471968909, -0.58795328419400639, -0.91000640381609366, 1.0758168861406918, 0.58840933306130239,
+      0.82722585763738421, 0.16563447036235229, 0.24426221535297279, 0.15214725374289301, 1.5817712712227332,
+  };
+
+  const double q[] = {
+      -0.0057123326505887362, 0.38621531909239332, 0.46364105682365181, -0.0098032923189391753, 3.3525722209647963e-09,
+      -2.5948515047829784e-09, -0.0098099990069972411, 3.2636077935295279e-09, -2.4080821766254911e-09, -0.0098080282458798077,
+      1.3306192805395304e-10, -2.8460413046263345e-10, -0.0098184439512048038, 4.4097500617837652e-11, -9.7834802304087341e-11,
+  };
+
+  Eigen::MatrixXd dense(15, 15);
+  for (int i = 0, k = 0; i < 15; ++i)
+    for (int j = 0; j <= i; ++j, ++k) dense(i, j) = dense(j, i) = lower[k];
+  const ledas::SparseMatrix w = dense.sparseView();
+  ledas::FrictionalProblem problem;
+  problem.w = &w;
+  problem.q = Eigen::Map<const ledas::Vector>(q, 15);
+  for (int c = 0; c < 5; ++c) {
+    problem.role.insert(problem.role.end(), {ledas::RowRole::normal, ledas::RowRole::tangent, ledas::RowRole::tangent});
+    problem.mu.insert(problem.mu.end(), {0.5, 0.0, 0.0});
+  }
+  problem.dofs = 12;
+  problem.tolerance = 1e-10 * problem.q.norm();
+  ledas::FrictionalSettings one_step;  // as before 2026-12-06: one fixed-point step, no sweeps
+  one_step.fixed_point_iterations = 1;
+  one_step.nonsmooth_sweeps = 0;
+  ledas::FrictionalSolver stalled(one_step), solver;
+  ledas::FrictionalStats stalled_stats, stats;
+  const ledas::Vector stuck = stalled.solve(problem, stalled_stats);
+  EXPECT_EQ(stalled_stats.non_converged, 1u);
+  EXPECT_GT(ledas::natural_map_residual(problem, stuck), 5.0 * problem.tolerance);
+  const ledas::Vector r = solver.solve(problem, stats);
+  EXPECT_EQ(stats.non_converged, 0u);
+  EXPECT_GT(stats.fixed_point_steps, 1u);
+  EXPECT_EQ(stats.nonsmooth_solved, 0u);
+  EXPECT_LE(ledas::natural_map_residual(problem, r), problem.tolerance);
+  const ledas::Vector u = w * r + problem.q;
+  const double tol = problem.tolerance;
+  for (int c = 0; c < 5; ++c) {
+    const double rn = r(3 * c), un = u(3 * c), friction = r.segment(3 * c + 1, 2).norm(), slip = u.segment(3 * c + 1, 2).norm();
+    EXPECT_GE(rn, -tol) << c;
+    EXPECT_GE(un, -tol) << c;
+    EXPECT_LE(std::abs(rn * un), tol) << c;
+    EXPECT_LE(friction, 0.5 * rn + tol) << c;
+    if (slip > 1e-6) {  // sliding: friction at the cone's edge, against the slip
+      EXPECT_NEAR(friction, 0.5 * rn, tol) << c;
+      EXPECT_NEAR(r.segment(3 * c + 1, 2).dot(u.segment(3 * c + 1, 2)), -friction * slip, tol) << c;
+    }
+  }
+  EXPECT_GT(u.segment(1, 2).norm(), 0.5);  // the fifth contact (first here) keeps sliding
+}
+
 // The proximal stage solves the problem it is given: on the relaxation, its subproblems are relaxations
 // too. The contact of the tests above doubled (two identical contacts, W = [I I; I I], q twice: one
 // redundant contact), relaxed, with no interior point and no Gauss–Seidel sweeps, so that only proximal

@@ -97,7 +97,7 @@ struct FrictionalSettings {
   /// solve (then the best iterate is returned and counted in non_converged).
   std::uint64_t max_newton_steps = 300;
   std::uint64_t interior_point_iterations = 60;  ///< interior-point steps on the convex relaxation at most
-  std::uint64_t fixed_point_iterations = 1;     ///< Cadoux's fixed-point steps (relaxations) at most
+  std::uint64_t fixed_point_iterations = 30;    ///< Cadoux's fixed-point steps (relaxations) at most
   std::uint64_t polish_newton_iterations = 8;   ///< Newton steps on Coulomb's problem from each of them
   std::uint64_t warm_newton_iterations = 2;     ///< Newton steps from a warm start that does not solve at once
   /// Newton steps more when those do not solve it: a sticking answer is taken, a slipping one only if
@@ -112,6 +112,10 @@ struct FrictionalSettings {
   /// nonsmooth Gauss–Seidel sweeps (each contact's own problem solved exactly in turn) from r = 0 at
   /// most, ended early when 512 sweeps do not halve the residual; then Newton from their iterate. 0: none.
   std::uint64_t nonsmooth_sweeps = 4096;
+  /// The last stages (Cadoux's fixed point beyond its first step, the nonsmooth sweeps) run on problems of
+  /// at most this many rows: above, each fixed-point step's interior point costs tens to hundreds of ms,
+  /// and on the frictional pile's islands of 1,000–2,300 rows they rarely solved what the stages left.
+  std::size_t last_stages_rows = 1000;
   /// A problem of at most this many contacts that the stages leave unsolved is tried with one contact
   /// released: a pressed contact that separates at the best iterate (r_n > 0, u_n > 0) may belong open,
   /// where Newton, having pressed every contact, stalls (a box's four points on the ground, one of them
@@ -188,7 +192,7 @@ class FrictionalSolver {
   void proximal_newton(const FrictionalProblem& problem, const std::vector<Block>& blocks, Vector& r,
                        FrictionalStats& stats);
   double nonsmooth_gauss_seidel(const FrictionalProblem& problem, const std::vector<Block>& blocks, Vector& r,
-                                FrictionalStats& stats);
+                                double entry, FrictionalStats& stats);
   double release_one_contact(const FrictionalProblem& problem, const std::vector<Block>& blocks, Vector& r,
                              FrictionalStats& stats);
 
