@@ -109,8 +109,9 @@ std::vector<Source> sources() {
   // The dropped pyramid K = 10 at μ = 0.7 with one of its 145 contacts left out: no longer symmetric. Of
   // ten contacts tried (7, 21, …, 137), eight leave a problem the convex relaxation solves in about 11
   // interior-point steps, as with all of them (7 here); without 137 it takes a fixed-point step and
-  // Newton; without 36 the Coulomb stages stall (error 5e-3 after 452 factorizations, 2026-12-03): a
-  // failure kept in view, as the stability atlas keeps its.
+  // Newton; without 36 the Coulomb stages stall (error 5e-3 after 452 factorizations, 2026-12-03) and
+  // the nonsmooth Gauss–Seidel sweeps solve it (since 2026-12-06): cases kept in view, as the stability
+  // atlas keeps its.
   for (const int gap : {7, 36, 137})
     out.push_back({"pyramid_drop_10_mu0.7_without_" + std::to_string(gap), "pyramid_drop_10.yaml", "",
                    {"generators.0.pyramid.friction=0.7"}, nullptr, 55, gap});

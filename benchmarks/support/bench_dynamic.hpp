@@ -182,17 +182,31 @@ inline void set_up_world(World& world, const std::vector<RigidBody>& bodies) {
 /// snapshot, as a running simulation would take it, first steps the engine from `before` untimed, so that
 /// what the engine carries from step to step (warm starts, contact caches) comes from a previous step,
 /// not from nothing and not from the timed step's own answer. Throws if a step fails.
+/// The lead-in itself is measured too (one thread): its resolver's time, and ledas's frictional island
+/// problems and those left above their tolerance, summed over its steps.
 struct DynamicStates {
   std::vector<RigidBody> before, at;
+  double lead_resolve_s = 0.0;
+  std::uint64_t lead_friction_problems = 0, lead_friction_non_converged = 0;
 };
 
 inline DynamicStates dynamic_states(const DynamicScene& scene) {
   World world;
   set_up_world(world, scene.start);
+  world.set_threads(1);
+  const std::shared_ptr<CollisionResolver> resolver = make_resolver("ledas", /*velocity_only=*/false);
+  const auto* ledas = dynamic_cast<const LedasResolver*>(resolver.get());
+  world.set_resolver(resolver);
   DynamicStates out;
   for (int i = 0; i < scene.lead_steps; ++i) {
     if (i + 1 == scene.lead_steps) out.before.assign(world.bodies().begin(), world.bodies().end());
-    if (const StepStatus& s = world.step(); !s.ok) throw std::runtime_error("the lead-in failed: " + s.message);
+    const StepStatus& s = world.step();
+    if (!s.ok) throw std::runtime_error("the lead-in failed: " + s.message);
+    out.lead_resolve_s += s.profile.resolve;
+    if (ledas != nullptr) {
+      out.lead_friction_problems += ledas->last_stats().friction.problems;
+      out.lead_friction_non_converged += ledas->last_stats().friction.non_converged;
+    }
   }
   out.at.assign(world.bodies().begin(), world.bodies().end());
   return out;

@@ -927,20 +927,21 @@ void FrictionalSolver::solve(const FrictionalProblem& problem, FrictionalStats& 
     residual = best_residual;
     // 3. Still not solved: the stages on Coulomb's problem from the best answer.
     if (residual > problem.tolerance) residual = solve_stages(problem, r, true, stats, settings_.max_newton_steps);
-    // 4. Still not solved, on a problem of at most `last_stages_rows` rows: Cadoux's fixed point goes on
+    // 4. Still not solved, on a problem of at most `fixed_point_rows` rows: Cadoux's fixed point goes on
     //    from the relaxation's last answer. Of 135 island problems of the frictional pile that the stages
     //    left unsolved (dumped from a run), it solves 114.
-    const bool small = static_cast<std::size_t>(problem.q.size()) <= settings_.last_stages_rows;
-    if (residual > problem.tolerance && more && small) {
+    const auto rows = static_cast<std::size_t>(problem.q.size());
+    if (residual > problem.tolerance && more && rows <= settings_.fixed_point_rows) {
       best = r;
       best_residual = residual;
       fixed_point(relaxation, settings_.fixed_point_iterations - 1);
       r = best;
       residual = best_residual;
     }
-    // 5. Still not solved (and as small): nonsmooth Gauss–Seidel sweeps from r = 0, then Newton from their
-    //    iterate, whose answer is taken where it solves the problem or improves on the best.
-    if (residual > problem.tolerance && settings_.nonsmooth_sweeps > 0 && small) {
+    // 5. Still not solved, up to `nonsmooth_rows` rows: nonsmooth Gauss–Seidel sweeps from r = 0, then
+    //    Newton from their iterate, whose answer is taken where it solves the problem or improves on the
+    //    best.
+    if (residual > problem.tolerance && settings_.nonsmooth_sweeps > 0 && rows <= settings_.nonsmooth_rows) {
       Vector& swept = buffers.sweep_r;
       swept.setZero(problem.q.size());
       double now = nonsmooth_gauss_seidel(problem, blocks, swept, residual, stats);
