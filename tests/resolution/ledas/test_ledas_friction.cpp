@@ -430,6 +430,28 @@ TEST(LedasFriction, SlippingWarmAnswerIsTakenOnlyWhereNoStaticEquilibriumExists)
   EXPECT_GE(declined, 10u);
 }
 
+// W (n × n) from its lower triangle by rows, as dumped problems are kept here.
+ledas::SparseMatrix symmetric_from_lower(const double* lower, int n) {
+  Eigen::MatrixXd dense(n, n);
+  for (int i = 0, k = 0; i < n; ++i)
+    for (int j = 0; j <= i; ++j, ++k) dense(i, j) = dense(j, i) = lower[k];
+  return dense.sparseView();
+}
+
+// The frictional problem of contacts with coefficient μ on W (3 rows each) and q, tolerance 1e-10 ‖q‖.
+ledas::FrictionalProblem frictional_contacts(const ledas::SparseMatrix& w, const double* q, double mu, std::size_t dofs) {
+  ledas::FrictionalProblem problem;
+  problem.w = &w;
+  problem.q = Eigen::Map<const ledas::Vector>(q, w.rows());
+  for (Eigen::Index c = 0; c < w.rows() / 3; ++c) {
+    problem.role.insert(problem.role.end(), {ledas::RowRole::normal, ledas::RowRole::tangent, ledas::RowRole::tangent});
+    problem.mu.insert(problem.mu.end(), {mu, 0.0, 0.0});
+  }
+  problem.dofs = dofs;
+  problem.tolerance = 1e-10 * problem.q.norm();
+  return problem;
+}
+
 // A problem the stages leave stalled, dumped from the frictional pile of bench_step (2026-12-05): one box
 // (6 degrees of freedom) on the ground at 4 contacts, μ = 0.5, two of them approaching at 1.57 m/s. Every
 // stage presses all four contacts and stalls at a natural-map residual of 1.9e-5; the solution leaves
@@ -458,19 +480,8 @@ TEST(LedasFriction, ReleasingOneContactSolvesWhereEveryStageStalls) {
   };
   const double q[] = {-1.5698639851772085, 0.26863832330346077, 0.19417066529508392, -1.5698821452072425, 0.26517984982081932, 0.20133870654283836, -0.0043893198394081567, 0.27463998747818952, 0.19546815186803573, -0.0043660217618699537, 0.27118151399554807, 0.20263619311579018};
 
-  Eigen::MatrixXd dense(12, 12);
-  for (int i = 0, k = 0; i < 12; ++i)
-    for (int j = 0; j <= i; ++j, ++k) dense(i, j) = dense(j, i) = lower[k];
-  const ledas::SparseMatrix w = dense.sparseView();
-  ledas::FrictionalProblem problem;
-  problem.w = &w;
-  problem.q = Eigen::Map<const ledas::Vector>(q, 12);
-  for (int c = 0; c < 4; ++c) {
-    problem.role.insert(problem.role.end(), {ledas::RowRole::normal, ledas::RowRole::tangent, ledas::RowRole::tangent});
-    problem.mu.insert(problem.mu.end(), {0.5, 0.0, 0.0});
-  }
-  problem.dofs = 6;
-  problem.tolerance = 1e-10 * problem.q.norm();
+  const ledas::SparseMatrix w = symmetric_from_lower(lower, 12);
+  const ledas::FrictionalProblem problem = frictional_contacts(w, q, 0.5, 6);
   ledas::FrictionalSettings without;
   without.release_max_contacts = 0;
   ledas::FrictionalSolver stalled(without), solver;
@@ -536,19 +547,8 @@ TEST(LedasFriction, CadouxFixedPointSolvesWhereTheStagesStall) {
       1.3306192805395304e-10, -2.8460413046263345e-10, -0.0098184439512048038, 4.4097500617837652e-11, -9.7834802304087341e-11,
   };
 
-  Eigen::MatrixXd dense(15, 15);
-  for (int i = 0, k = 0; i < 15; ++i)
-    for (int j = 0; j <= i; ++j, ++k) dense(i, j) = dense(j, i) = lower[k];
-  const ledas::SparseMatrix w = dense.sparseView();
-  ledas::FrictionalProblem problem;
-  problem.w = &w;
-  problem.q = Eigen::Map<const ledas::Vector>(q, 15);
-  for (int c = 0; c < 5; ++c) {
-    problem.role.insert(problem.role.end(), {ledas::RowRole::normal, ledas::RowRole::tangent, ledas::RowRole::tangent});
-    problem.mu.insert(problem.mu.end(), {0.5, 0.0, 0.0});
-  }
-  problem.dofs = 12;
-  problem.tolerance = 1e-10 * problem.q.norm();
+  const ledas::SparseMatrix w = symmetric_from_lower(lower, 15);
+  const ledas::FrictionalProblem problem = frictional_contacts(w, q, 0.5, 12);
   ledas::FrictionalSettings one_step;  // as before 2026-12-06: one fixed-point step, no sweeps
   one_step.fixed_point_iterations = 1;
   one_step.nonsmooth_sweeps = 0;
