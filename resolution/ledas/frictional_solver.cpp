@@ -833,7 +833,7 @@ void FrictionalSolver::solve(const FrictionalProblem& problem, FrictionalStats& 
   }
   if (problem.convex) {
     if (warm) r = *problem.start;
-    residual = solve_stages(problem, r, warm, stats, settings_.max_newton_steps);
+    residual = solve_stages(problem, r, warm, stats);
   } else {
     // 1. The convex relaxation: among Coulomb's solutions of a redundant problem it picks the one a
     //    static equilibrium gives, whenever one exists (velocities 0 where the relaxation's are, see
@@ -863,7 +863,7 @@ void FrictionalSolver::solve(const FrictionalProblem& problem, FrictionalStats& 
       r = buffers_->warm_answer;
       residual = natural_map_residual(problem, r);
     } else {
-      relaxed_residual = solve_stages(relaxed, r, false, stats, settings_.max_newton_steps);
+      relaxed_residual = solve_stages(relaxed, r, false, stats);
       residual = natural_map_residual(problem, r);
       if (residual > problem.tolerance && warm_slips) {  // no static equilibrium: the warm start's answer
         r = buffers_->warm_answer;
@@ -909,7 +909,7 @@ void FrictionalSolver::solve(const FrictionalProblem& problem, FrictionalStats& 
         relaxed.q = problem.q;
         for (const Block& block : blocks)
           if (block.size == 3) relaxed.q(block.first) += block.mu * std::hypot(u(block.first + 1), u(block.first + 2));
-        if (solve_stages(relaxed, from, false, stats, settings_.max_newton_steps) > relaxed.tolerance) return false;
+        if (solve_stages(relaxed, from, false, stats) > relaxed.tolerance) return false;
         const double relaxed_now = natural_map_residual(problem, from);
         own = std::min(own, relaxed_now);
         if (relaxed_now < best_residual) {
@@ -926,7 +926,7 @@ void FrictionalSolver::solve(const FrictionalProblem& problem, FrictionalStats& 
     r = best;
     residual = best_residual;
     // 3. Still not solved: the stages on Coulomb's problem from the best answer.
-    if (residual > problem.tolerance) residual = solve_stages(problem, r, true, stats, settings_.max_newton_steps);
+    if (residual > problem.tolerance) residual = solve_stages(problem, r, true, stats);
     // 4. Still not solved, on a problem of at most `fixed_point_rows` rows: Cadoux's fixed point goes on
     //    from the relaxation's last answer. Of 135 island problems of the frictional pile that the stages
     //    left unsolved (dumped from a run), it solves 114.
@@ -1095,14 +1095,13 @@ double FrictionalSolver::release_one_contact(const FrictionalProblem& problem, c
 
 // The stages (file comment) on `problem` from r, which they overwrite with the best iterate met; returns
 // its natural-map residual.
-double FrictionalSolver::solve_stages(const FrictionalProblem& problem, Vector& r, bool warm, FrictionalStats& stats,
-                                      std::uint64_t budget) {
+double FrictionalSolver::solve_stages(const FrictionalProblem& problem, Vector& r, bool warm, FrictionalStats& stats) {
   const SparseMatrix& w = *problem.w;
   FrictionalWorkspace::Newton& buffers = *buffers_;
   const Vector& diagonal = buffers.stage_diagonal = w.diagonal();
   make_blocks(problem, diagonal, buffers.stage_blocks);
   const std::vector<Block>& blocks = buffers.stage_blocks;
-  steps_left_ = budget;
+  steps_left_ = settings_.max_newton_steps;
 
   // 1. Newton on the problem itself: enough whenever W is well conditioned on the contacts that end up
   //    pressed, or near a solution.

@@ -19,9 +19,10 @@
 ///     Newton on its natural map: a static equilibrium is its answer whenever one exists, and where its
 ///     answer has no pressed contact slipping it is Coulomb's answer;
 ///  2. else Newton on Coulomb's problem from it, one step of Cadoux's fixed point (the relaxation with q_n
-///     raised by μ‖u_t‖), and the stages below;
-///  3. still unsolved: nonsmooth Gauss–Seidel sweeps from r = 0 (each contact's own problem solved
-///     exactly in turn), then Newton from their iterate;
+///     raised by μ‖u_t‖), and the Newton stages below;
+///  3. still unsolved: more of Cadoux's steps (`fixed_point_iterations`, on problems of at most
+///     `fixed_point_rows`), then nonsmooth Gauss–Seidel sweeps from r = 0 (each contact's own problem
+///     solved exactly in turn; at most `nonsmooth_rows`) and Newton from their iterate;
 ///  4. a cold answer within the tolerance gets a few Newton steps past it (exact to rounding). The Newton
 ///     stages: a semismooth Newton method on the Alart–Curnier function
 ///   F_n = r_n − max(0, z_n),  z_n = r_n − ρ_n u_n,
@@ -97,7 +98,9 @@ struct FrictionalSettings {
   /// solve (then the best iterate is returned and counted in non_converged).
   std::uint64_t max_newton_steps = 300;
   std::uint64_t interior_point_iterations = 60;  ///< interior-point steps on the convex relaxation at most
-  std::uint64_t fixed_point_iterations = 30;    ///< Cadoux's fixed-point steps (relaxations) at most
+  /// Cadoux's fixed-point steps (relaxations) at most: the first before the Newton stages, the others
+  /// after them if they fail (up to `fixed_point_rows`), ended when 3 steps do not halve their residual.
+  std::uint64_t fixed_point_iterations = 30;
   std::uint64_t polish_newton_iterations = 8;   ///< Newton steps on Coulomb's problem from each of them
   std::uint64_t warm_newton_iterations = 2;     ///< Newton steps from a warm start that does not solve at once
   /// Newton steps more when those do not solve it: a sticking answer is taken, a slipping one only if
@@ -187,8 +190,7 @@ class FrictionalSolver {
   struct Block;  // one contact's rows (frictional_solver.cpp)
 
  private:
-  double solve_stages(const FrictionalProblem& problem, Vector& r, bool warm, FrictionalStats& stats,
-                      std::uint64_t budget);
+  double solve_stages(const FrictionalProblem& problem, Vector& r, bool warm, FrictionalStats& stats);
   double newton(const FrictionalProblem& problem, const std::vector<Block>& blocks, Vector& r,
                 std::uint64_t iterations, FrictionalStats& stats);
   void proximal_newton(const FrictionalProblem& problem, const std::vector<Block>& blocks, Vector& r,
