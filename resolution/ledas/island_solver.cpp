@@ -148,6 +148,7 @@ void add(SolverStats& into, const SolverStats& part) {
   into.sharpened += part.sharpened;
   into.interior_point_steps += part.interior_point_steps;
   into.interior_point_solved += part.interior_point_solved;
+  into.interior_point_loose += part.interior_point_loose;
 }
 
 }  // namespace impetus::ledas

@@ -83,6 +83,9 @@ struct SolverStats {
   std::uint64_t sharpened = 0;    ///< refinements that refactored at a smaller shift (fewer steps)
   std::uint64_t interior_point_steps = 0;   ///< body-space interior-point steps (one factorization each)
   std::uint64_t interior_point_solved = 0;  ///< problems the body-space interior point solved
+  /// Of those, the answers taken at a stall within 10× the stopping rule's complementarity bound
+  /// (body_space.cpp, kStalledExcess) instead of falling back to the active-set search.
+  std::uint64_t interior_point_loose = 0;
 };
 
 /// Adds the counts of `part` to `into`.
