@@ -26,14 +26,18 @@ constexpr double kRegularization = 1e-10;  // δ = this · max A_kk (below)
 // longer get there before the regularization's floor and fall back to the search.
 constexpr double kComplementarity = 1e-4;
 constexpr int kStallSteps = 10;  // steps without a better iterate before the search takes over
-// Creeping: kStallSteps steps have not halved the best excess. Then, or at a stall, an iterate within
-// kStalledExcess of the rule (and with no row approaching) is taken: the rule's products at 10× (1e-3 ·
-// tolerance · max p), where velocities came within ~2.5e-10 m/s of the search's (the wall of 80 cubes
-// above, interpolated). On the knocked wall of 200 bricks, step 10's impact problem crept at 2.1–2.4×
-// the bound for 70 steps: a row pressing with 20 N·s separated at 3.8e-12 m/s, the regularization's
-// δ·dp while its impulse drifted to redundant rows at 0.08 N·s a step. The search then took 1,721
-// iterations, that step 0.55–0.83 s against ~30 ms for the others.
-constexpr double kStalledExcess = 10.0;
+// Creeping: kStallSteps steps have not halved the best excess. Then, or at a stall, the best iterate is
+// taken if it is within SolverSettings::interior_point_stall_excess (100) of the rule with no row
+// approaching (counted as loose): products p_k w_k up to 1e-2 · tolerance · max p. Such a stall is the regularization's floor, where rows that
+// press move their impulse onto redundant neighbours by a little each step and separate at δ·dp while
+// they do; the velocities have converged (primal and dual residuals 1e-11–1e-15 on the walls below).
+// Measured on bench_step's knocked walls stepped from their start (one thread):
+//  - 200 bricks, step 10: the impact problem crept at 2.1–2.4× the bound for 70 steps (a row pressing
+//    with 20 N·s separated at 3.8e-12 m/s while its impulse moved at 0.08 N·s a step); the search then
+//    took 1,721 iterations, the step 0.55–0.83 s against 25–45 ms for its neighbours.
+//  - 1,000 bricks (11,500 rows): impact problems stalled at 4–11× and position corrections (tolerance
+//    1e-12 m) at 19–29×, p_k w_k ~ 1e-17 m·N·s; each fell to the search, 9,700–10,100 iterations and
+//    29–46 s for the step, against 0.5–1 s for the others.
 // Gondzio's multiple centrality correctors (J. Gondzio, "Multiple centrality corrections in a primal-dual
 // method for linear programming", Comput. Optim. Appl. 6, 1996): at most kCorrectors per step, each one
 // more solve on the step's factorization, aimed at the trial step min(1, 1.5 α + 0.1) and kept only if it
@@ -188,8 +192,8 @@ bool suits_body_space(const ComplementarityProblem& problem, const SolverSetting
   return std::none_of(problem.equality.begin(), problem.equality.end(), [](char e) { return e != 0; });
 }
 
-bool solve_in_body_space(const ComplementarityProblem& problem, BodySpaceWorkspace& work, SolverStats& stats,
-                         Vector& p_out) {
+bool solve_in_body_space(const ComplementarityProblem& problem, double stall_excess, BodySpaceWorkspace& work,
+                         SolverStats& stats, Vector& p_out) {
   const BodySpace& body = *problem.body_space;
   const SparseMatrix& a = *problem.matrix;
   const Vector& c = problem.rhs;
@@ -213,6 +217,7 @@ bool solve_in_body_space(const ComplementarityProblem& problem, BodySpaceWorkspa
   const double delta = kRegularization * a_scale;
   double best = std::numeric_limits<double>::infinity(), mark = best;  // mark: the best kStallSteps steps ago
   int best_step = 0;
+  bool best_usable = false;  // the best iterate is within stall_excess of the rule, no row approaching
   for (int step = 0; step < kMaxSteps; ++step) {
     // Residuals: dual M u − Gᵀ p, primal G u − c − s, and the mean complementarity μ.
     multiply_m(body, u, work.dual);
@@ -226,15 +231,23 @@ bool solve_in_body_space(const ComplementarityProblem& problem, BodySpaceWorkspa
     work.w.noalias() = a * p;
     work.w -= c;
     const double worst = excess(p, work.w, c, tolerance, a_scale);
-    if (worst < best) best = worst, best_step = step;
+    if (worst < best) {
+      best = worst;
+      best_step = step;
+      // The best iterate a stall may take (below): kept while it is within reach of being taken.
+      best_usable = worst <= stall_excess && work.w.minCoeff() >= -tolerance;
+      if (best_usable) work.best = p;
+    }
     const bool stalled = step - best_step > kStallSteps;  // at the regularization's or rounding's floor
     bool creeping = false;
     if (step > 0 && step % kStallSteps == 0) {
       creeping = best > 0.5 * mark;
       mark = best;
     }
-    if ((stalled || creeping) && worst <= kStalledExcess && work.w.minCoeff() >= -tolerance) {
-      accept(problem, a_scale, p, work, p_out);
+    if ((stalled || creeping) && best_usable) {
+      work.w.noalias() = a * work.best;
+      work.w -= c;
+      accept(problem, a_scale, work.best, work, p_out);
       ++stats.interior_point_solved;
       ++stats.interior_point_loose;
       return true;

@@ -25,6 +25,7 @@ struct BodySpaceWorkspace {
   std::vector<std::pair<SparseIndex, SparseIndex>> pairs;  ///< build_pattern's scratch
   Vector u, p, s, dual, primal, ratio, rhs, du, ds, dp, du_aff, ds_aff, dp_aff, target, complement, candidate, w,
       check;
+  Vector best;  ///< the best iterate within reach of a stall's acceptance (body_space.cpp)
 };
 
 /// Whether `problem` goes to the interior point first: it brings its body-space form, has no equality
@@ -36,9 +37,11 @@ bool suits_body_space(const ComplementarityProblem& problem, const SolverSetting
 /// Mehrotra's predictor–corrector; its multipliers are p. Returns true, with p, once p ≥ 0 and
 /// w = A p − c meet the ε-complementarity rule: w ≥ −tolerance on every row and p_k w_k ≤
 /// max(1e-4 · tolerance, rounding) · max p (rows separating by more than the tolerance then let go of
-/// their impulses if the rule still holds without them). Otherwise (its step cap, a stall, a pivot ≤ 0)
-/// false, p untouched.
-bool solve_in_body_space(const ComplementarityProblem& problem, BodySpaceWorkspace& work, SolverStats& stats,
-                         Vector& p);
+/// their impulses if the rule still holds without them). At a stall (no better iterate in 10 steps, or
+/// 10 steps that do not halve the best), its best iterate if no row approaches there and its products
+/// are within `stall_excess` of that bound (SolverStats::interior_point_loose). Otherwise (its step cap,
+/// a stall, a pivot ≤ 0) false, p untouched.
+bool solve_in_body_space(const ComplementarityProblem& problem, double stall_excess, BodySpaceWorkspace& work,
+                         SolverStats& stats, Vector& p);
 
 }  // namespace impetus::ledas

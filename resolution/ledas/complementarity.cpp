@@ -248,7 +248,9 @@ void ComplementaritySolver::solve(const ComplementarityProblem& problem, SolverS
     }
     return;
   }
-  if (suits_body_space(problem, settings_) && solve_in_body_space(problem, body_space_, stats, p)) return;
+  if (suits_body_space(problem, settings_) &&
+      solve_in_body_space(problem, settings_.interior_point_stall_excess, body_space_, stats, p))
+    return;
   Search search(problem, settings_, scale, *work_);
   search.loop.groups = problem.groups;
   search.loop.factor =

@@ -66,6 +66,11 @@ struct SolverSettings {
   /// first by a primal–dual interior point in body space, whose system stays positive definite; the
   /// active-set search takes over if it does not meet the search's own stopping rule. 0: never.
   std::size_t interior_point_rows = 500;
+  /// Where that interior point stalls at the regularization's floor (resolution/ledas/README.md,
+  /// "Creeping at the floor"), its best iterate is taken if no row approaches and its complementarity
+  /// products are within this factor of the stopping rule's bound; else the active-set search takes
+  /// over (exact, but up to thousands of iterations on a large wall). Below 1: never taken at a stall.
+  double interior_point_stall_excess = 100.0;
 };
 
 }  // namespace ledas
@@ -85,7 +90,8 @@ struct LedasSettings {
   /// Complementary mode: the active-set search's first guess. Option `start_set: impact | touching`.
   LedasStartSet start_set = LedasStartSet::impact;
   /// Options `dense_limit`, `polish_limit`, `rank_tolerance`, `update_limit`, `regularization`,
-  /// `search_regularization`, `sharpen_refinement`, `interior_point_rows` (max_iterations is set to max_rounds).
+  /// `search_regularization`, `sharpen_refinement`, `interior_point_rows`, `interior_point_stall_excess`
+  /// (max_iterations is set to max_rounds).
   ledas::SolverSettings solver;
   /// Solve each island (rows connected through movable bodies) on its own (default), or every row in
   /// one system (`islands: false`: the same velocities up to rounding, with the bounce threshold judged
@@ -122,6 +128,8 @@ struct LedasSettings {
     s.solver.sharpen_refinement = options.boolean("sharpen_refinement", s.solver.sharpen_refinement);
     s.solver.interior_point_rows = static_cast<std::size_t>(options.integer(
         "interior_point_rows", static_cast<long long>(s.solver.interior_point_rows), 0, 1'000'000'000));
+    s.solver.interior_point_stall_excess =
+        options.number("interior_point_stall_excess", s.solver.interior_point_stall_excess, 0.0, 1e6);
     s.solver.max_iterations = s.max_rounds;
     s.islands = options.boolean("islands", s.islands);
     s.warm_start = options.boolean("warm_start", s.warm_start);
@@ -147,6 +155,7 @@ struct LedasSettings {
     put(o, "sharpen_refinement", solver.sharpen_refinement, d.solver.sharpen_refinement);
     put(o, "interior_point_rows", static_cast<long long>(solver.interior_point_rows),
         static_cast<long long>(d.solver.interior_point_rows));
+    put(o, "interior_point_stall_excess", solver.interior_point_stall_excess, d.solver.interior_point_stall_excess);
     put(o, "islands", islands, d.islands);
     put(o, "warm_start", warm_start, d.warm_start);
     resting.add_options(o);
