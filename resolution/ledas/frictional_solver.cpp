@@ -80,7 +80,7 @@ struct Linearization {
 struct FrictionalWorkspace::Newton {
   std::vector<Block> blocks;
   Vector diagonal;
-  Vector best, u, f, trial, u_trial, f_trial, d;
+  Vector best, u, f, trial, u_trial, f_trial, d, wd;
   std::vector<Linearization> lin, lin_trial;
   Eigen::MatrixXd jacobian;  // the dense path's
   Eigen::PartialPivLU<Eigen::MatrixXd> lu;
@@ -712,13 +712,16 @@ double FrictionalSolver::newton(const FrictionalProblem& problem, const std::vec
       break;
     }
     stats.newton_reused += buffers.reused ? 1 : 0;
-    // Armijo on ½‖F‖²: its derivative along the Newton direction is −‖F‖² = −2 merit.
+    // Armijo on ½‖F‖²: its derivative along the Newton direction is −‖F‖² = −2 merit. u is affine in r,
+    // so a trial's u = W (r + step d) + q is u + step W d: one product with W per step, however many
+    // trials the line search takes.
+    Vector& wd = buffers.wd;
+    wd.noalias() = w.transpose() * d;  // = W d (symmetric), as a gather
     double step = 1.0, trial_merit = merit;
     bool accepted = false;
     for (; step >= kShortestStep; step *= 0.5) {
       trial = r + step * d;
-      u_trial.noalias() = w.transpose() * trial;  // = W trial (symmetric), as a gather
-      u_trial += problem.q;
+      u_trial = u + step * wd;
       evaluate(blocks, trial, u_trial, f_trial, lin_trial);
       trial_merit = 0.5 * f_trial.squaredNorm();
       if (trial_merit <= (1.0 - 2.0 * kArmijo * step) * merit) {
@@ -732,7 +735,7 @@ double FrictionalSolver::newton(const FrictionalProblem& problem, const std::vec
     f.swap(f_trial);
     lin.swap(lin_trial);
     merit = trial_merit;
-    // u is W r + q already (the trial's, computed as natural_map_residual computes it).
+    // u is W r + q (to rounding: the sum of the steps' W d, not recomputed from r).
     if (const double residual = natural_map_residual(problem, r, u); residual < best_residual) {
       best_residual = residual;
       best = r;
