@@ -28,9 +28,10 @@ constexpr double kComplementarity = 1e-4;
 constexpr int kStallSteps = 10;  // steps without a better iterate before the search takes over
 // Creeping: kStallSteps steps have not halved the best excess. Then, or at a stall, the best iterate is
 // taken if it is within SolverSettings::interior_point_stall_excess (100) of the rule with no row
-// approaching (counted as loose): products p_k w_k up to 1e-2 · tolerance · max p. Such a stall is the regularization's floor, where rows that
-// press move their impulse onto redundant neighbours by a little each step and separate at δ·dp while
-// they do; the velocities have converged (primal and dual residuals 1e-11–1e-15 on the walls below).
+// approaching (counted as loose): products p_k w_k up to 1e-2 · tolerance · max p. Such a stall is the
+// regularization's floor, where rows that press move their impulse onto redundant neighbours by a
+// little each step and separate at δ·dp while they do; the velocities have converged (primal and dual
+// residuals 1e-11–1e-15 on the walls below).
 // Measured on bench_step's knocked walls stepped from their start (one thread):
 //  - 200 bricks, step 10: the impact problem crept at 2.1–2.4× the bound for 70 steps (a row pressing
 //    with 20 N·s separated at 3.8e-12 m/s while its impulse moved at 0.08 N·s a step); the search then
@@ -166,6 +167,7 @@ void system_values(const BodySpace& body, const Vector& d, BodySpaceWorkspace& w
     block(at[3]).noalias() += (dk * gb) * gb.transpose();
   }
 }
+
 // An iterate p (w = A p − c in work.w) that meets the stopping rule into p_out: the rows that separate by
 // more than the tolerance let go of their (small) impulses if the rule still holds without them.
 void accept(const ComplementarityProblem& problem, double a_scale, const Vector& p, BodySpaceWorkspace& work,
@@ -238,6 +240,11 @@ bool solve_in_body_space(const ComplementarityProblem& problem, double stall_exc
       best_usable = worst <= stall_excess && work.w.minCoeff() >= -tolerance;
       if (best_usable) work.best = p;
     }
+    if (worst <= 1.0) {
+      accept(problem, a_scale, p, work, p_out);
+      ++stats.interior_point_solved;
+      return true;
+    }
     const bool stalled = step - best_step > kStallSteps;  // at the regularization's or rounding's floor
     bool creeping = false;
     if (step > 0 && step % kStallSteps == 0) {
@@ -253,11 +260,6 @@ bool solve_in_body_space(const ComplementarityProblem& problem, double stall_exc
       return true;
     }
     if (stalled) return false;
-    if (worst <= 1.0) {
-      accept(problem, a_scale, p, work, p_out);
-      ++stats.interior_point_solved;
-      return true;
-    }
 
     // The Newton system in body space, regularized (primal–dual regularization): the primal equation
     // G du − ds = −r_p gets + δ dp, which caps D = (S P⁻¹ + δ)⁻¹ at 1/δ. Without it D grows without bound
