@@ -34,6 +34,7 @@ TEST(TypedSettings, SurviveTheRoundTripThroughOptionsExactly) {
   ledas.solver.search_regularization = 0.0;
   ledas.solver.sharpen_refinement = false;
   ledas.solver.interior_point_rows = 1234;
+  ledas.solver.interior_point_stall_excess = 1.0 / 3.0;
   ledas.islands = false;
   ledas.warm_start = false;
   ledas.resting.slop = 1.0 / 7.0 * 1e-3;
@@ -53,6 +54,7 @@ TEST(TypedSettings, SurviveTheRoundTripThroughOptionsExactly) {
   EXPECT_EQ(l.solver.search_regularization, ledas.solver.search_regularization);
   EXPECT_EQ(l.solver.sharpen_refinement, ledas.solver.sharpen_refinement);
   EXPECT_EQ(l.solver.interior_point_rows, ledas.solver.interior_point_rows);
+  EXPECT_EQ(l.solver.interior_point_stall_excess, ledas.solver.interior_point_stall_excess);
   EXPECT_EQ(l.islands, ledas.islands);
   EXPECT_EQ(l.warm_start, ledas.warm_start);
   EXPECT_EQ(l.resting.slop, ledas.resting.slop);

@@ -226,6 +226,7 @@ TEST(LedasWorld, OptionsAreReadAndChecked) {
   set("sharpen_refinement", "false");
   set("start_set", "touching");
   set("interior_point_rows", "0");
+  set("interior_point_stall_excess", "10");
   const LedasSettings s = LedasSettings::from_options(options);
   EXPECT_TRUE(options.unread().empty());
   EXPECT_EQ(s.mode, LedasMode::paper);
@@ -235,6 +236,7 @@ TEST(LedasWorld, OptionsAreReadAndChecked) {
   EXPECT_FALSE(s.solver.sharpen_refinement);
   EXPECT_EQ(s.start_set, LedasStartSet::touching);
   EXPECT_EQ(s.solver.interior_point_rows, 0u);
+  EXPECT_DOUBLE_EQ(s.solver.interior_point_stall_excess, 10.0);
   EXPECT_DOUBLE_EQ(s.resting.correction, 0.5);
   set("mode", "sequential");
   EXPECT_THROW(LedasSettings::from_options(options), OptionError);
@@ -244,6 +246,11 @@ TEST(LedasWorld, OptionsAreReadAndChecked) {
   set("start_set", "impact");
   set("interior_point_rows", "-1");
   EXPECT_THROW(LedasSettings::from_options(options), OptionError);
+  set("interior_point_rows", "0");
+  for (const char* bad : {"-1", "nan", "1e7"}) {
+    set("interior_point_stall_excess", bad);
+    EXPECT_THROW(LedasSettings::from_options(options), OptionError) << bad;
+  }
 }
 
 // Constraints: point-point and coaxial are accepted, a coaxial joint with a zero axis is refused.
