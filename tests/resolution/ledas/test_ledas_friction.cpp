@@ -552,6 +552,7 @@ TEST(LedasFriction, CadouxFixedPointSolvesWhereTheStagesStall) {
   ledas::FrictionalSettings one_step;  // as before 2026-12-06: one fixed-point step, no sweeps
   one_step.fixed_point_iterations = 1;
   one_step.nonsmooth_sweeps = 0;
+  one_step.projection_iterations = 0;  // nor the projection stage (2026-12-06, later)
   ledas::FrictionalSolver stalled(one_step), solver;
   ledas::FrictionalStats stalled_stats, stats;
   const ledas::Vector stuck = stalled.solve(problem, stalled_stats);

@@ -22,7 +22,9 @@
 ///     raised by μ‖u_t‖), and the Newton stages below;
 ///  3. still unsolved: more of Cadoux's steps (`fixed_point_iterations`, on problems of at most
 ///     `fixed_point_rows`), then nonsmooth Gauss–Seidel sweeps from r = 0 (each contact's own problem
-///     solved exactly in turn; at most `nonsmooth_rows`) and Newton from their iterate;
+///     solved exactly in turn; at most `nonsmooth_rows`) and Newton from their iterate, or on larger
+///     problems (up to `projection_rows`) a projected fixed point r ← P_K(r − ρ D F(r)) on Coulomb's
+///     variational inequality from the relaxation's answer, with Newton from its iterates;
 ///  4. a cold answer within the tolerance gets a few Newton steps past it (exact to rounding). The Newton
 ///     stages: a semismooth Newton method on the Alart–Curnier function
 ///   F_n = r_n − max(0, z_n),  z_n = r_n − ρ_n u_n,
@@ -121,6 +123,13 @@ struct FrictionalSettings {
   std::size_t fixed_point_rows = 400;
   /// The nonsmooth sweeps run on problems of at most this many rows (a sweep of 2,000 rows costs ~0.5 ms).
   std::size_t nonsmooth_rows = 1000;
+  /// Where the sweeps leave it unsolved too: projected fixed-point iterations on Coulomb's variational
+  /// inequality from the relaxation's answer, at most this many (one product with W each), ended early
+  /// when 16,384 do not halve the residual; Newton is tried from their iterate as it nears a solution. 0: none.
+  std::uint64_t projection_iterations = 131072;
+  /// The projection stage runs on problems of at most this many rows (an iteration of 1,770 rows, the
+  /// sphere pyramid K = 20, costs ~25 µs).
+  std::size_t projection_rows = 4000;
   /// A problem of at most this many contacts that the stages leave unsolved is tried with one contact
   /// released: a pressed contact that separates at the best iterate (r_n > 0, u_n > 0) may belong open,
   /// where Newton, having pressed every contact, stalls (a box's four points on the ground, one of them
@@ -153,6 +162,8 @@ struct FrictionalStats {
   std::uint64_t proximal_steps = 0;    ///< its proximal points (a Newton solve each)
   std::uint64_t nonsmooth_sweeps = 0;  ///< nonsmooth Gauss–Seidel sweeps (FrictionalSettings::nonsmooth_sweeps)
   std::uint64_t nonsmooth_solved = 0;  ///< problems those sweeps (and Newton from them) solved
+  std::uint64_t projection_iterations = 0;  ///< projected fixed-point iterations (FrictionalSettings::projection_iterations)
+  std::uint64_t projection_solved = 0;      ///< problems that stage (and Newton from its iterates) solved
   std::uint64_t fallbacks = 0;         ///< problems where the projected Gauss–Seidel fallback ran
   std::uint64_t fallback_sweeps = 0;   ///< its sweeps
   std::uint64_t non_converged = 0;     ///< problems left above the tolerance (best iterate returned)
@@ -197,6 +208,8 @@ class FrictionalSolver {
                        FrictionalStats& stats);
   double nonsmooth_gauss_seidel(const FrictionalProblem& problem, const std::vector<Block>& blocks, Vector& r,
                                 double entry, FrictionalStats& stats);
+  double projection(const FrictionalProblem& problem, const std::vector<Block>& blocks, Vector& r, double entry,
+                    FrictionalStats& stats);
   double release_one_contact(const FrictionalProblem& problem, const std::vector<Block>& blocks, Vector& r,
                              FrictionalStats& stats);
 
