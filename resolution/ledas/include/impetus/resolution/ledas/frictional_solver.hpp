@@ -23,8 +23,8 @@
 ///  3. still unsolved: more of Cadoux's steps (`fixed_point_iterations`, on problems of at most
 ///     `fixed_point_rows`), then nonsmooth Gauss–Seidel sweeps from r = 0 (each contact's own problem
 ///     solved exactly in turn; at most `nonsmooth_rows`) and Newton from their iterate, or on larger
-///     problems (up to `projection_rows`) a projected fixed point r ← P_K(r − ρ D F(r)) on Coulomb's
-///     variational inequality from the relaxation's answer, with Newton from its iterates;
+///     problems solved cold (up to `projection_rows`) a projected fixed point r ← P_K(r − ρ D F(r)) on
+///     Coulomb's variational inequality from the relaxation's answer, with Newton from its iterates;
 ///  4. a cold answer within the tolerance gets a few Newton steps past it (exact to rounding). The Newton
 ///     stages: a semismooth Newton method on the Alart–Curnier function
 ///   F_n = r_n − max(0, z_n),  z_n = r_n − ρ_n u_n,
@@ -123,9 +123,11 @@ struct FrictionalSettings {
   std::size_t fixed_point_rows = 400;
   /// The nonsmooth sweeps run on problems of at most this many rows (a sweep of 2,000 rows costs ~0.5 ms).
   std::size_t nonsmooth_rows = 1000;
-  /// Where the sweeps leave it unsolved too: projected fixed-point iterations on Coulomb's variational
+  /// Where the sweeps do not run (above `nonsmooth_rows`, or switched off) and the stages leave a cold
+  /// problem (no warm start) unsolved: projected fixed-point iterations on Coulomb's variational
   /// inequality from the relaxation's answer, at most this many (one product with W each), ended early
-  /// when 16,384 do not halve the residual; Newton is tried from their iterate as it nears a solution. 0: none.
+  /// when 16,384 do not halve the residual or 4,096 do not come within 10× of the stages' best; Newton
+  /// is tried from their iterate as it nears a solution. 0: none.
   std::uint64_t projection_iterations = 131072;
   /// The projection stage runs on problems of at most this many rows (an iteration of 1,770 rows, the
   /// sphere pyramid K = 20, costs ~25 µs).
