@@ -10,6 +10,7 @@
 #include "cone_qp.hpp"
 
 #include <algorithm>
+#include <numeric>
 #include <cassert>
 #include <cmath>
 #include <limits>
@@ -126,7 +127,8 @@ double max_step(const std::vector<Cone>& cones, const Vector& x, const Vector& d
 }
 
 // h's pattern (W's, with every cone's diagonal block) and where W's entries and the blocks are stored in
-// it; rebuilt (allocating) only when W's pattern changed or a cone's block is not in h.
+// it; rebuilt (allocating) only when W's pattern changed or a cone's block is not in h, and from
+// triplets only when a cone's block is not in W's pattern.
 void prepare_pattern(const SparseMatrix& w, ConeQpWorkspace& ws) {
   const Eigen::Index m = w.rows();
   const auto position = [&ws](Eigen::Index row, Eigen::Index col) -> SparseIndex {
@@ -150,7 +152,16 @@ void prepare_pattern(const SparseMatrix& w, ConeQpWorkspace& ws) {
                       std::equal(ws.outer.begin(), ws.outer.end(), w.outerIndexPtr()) &&
                       ws.inner.size() == static_cast<std::size_t>(w.nonZeros()) &&
                       std::equal(ws.inner.begin(), ws.inner.end(), w.innerIndexPtr());
-  if (!same_w || !locate_blocks()) {
+  ws.every_row.assign(static_cast<std::size_t>(m), 1);
+  if (same_w && locate_blocks()) return;
+  // Usually every cone's block is in W's pattern already (a contact's three rows have the same bodies,
+  // so the same columns): then h's pattern is W's, entry for entry, and no triplets are needed.
+  ws.h = w;
+  ws.h.makeCompressed();
+  if (locate_blocks()) {
+    ws.from_w.resize(static_cast<std::size_t>(w.nonZeros()));
+    std::iota(ws.from_w.begin(), ws.from_w.end(), SparseIndex{0});
+  } else {
     std::vector<Eigen::Triplet<double>> entries;
     entries.reserve(static_cast<std::size_t>(w.nonZeros()) + 9 * ws.cones.size());
     for (Eigen::Index col = 0; col < m; ++col)
@@ -164,15 +175,14 @@ void prepare_pattern(const SparseMatrix& w, ConeQpWorkspace& ws) {
     ws.from_w.clear();
     for (Eigen::Index col = 0; col < m; ++col)
       for (SparseMatrix::InnerIterator it(w, col); it; ++it) ws.from_w.push_back(position(it.row(), col));
-    ws.outer.clear();  // the key: W's compressed pattern (an uncompressed W is laid out afresh every time)
-    ws.inner.clear();
-    if (w.isCompressed()) {
-      ws.outer.assign(w.outerIndexPtr(), w.outerIndexPtr() + m + 1);
-      ws.inner.assign(w.innerIndexPtr(), w.innerIndexPtr() + w.nonZeros());
-    }
     locate_blocks();
   }
-  ws.every_row.assign(static_cast<std::size_t>(m), 1);
+  ws.outer.clear();  // the key: W's compressed pattern (an uncompressed W is laid out afresh every time)
+  ws.inner.clear();
+  if (w.isCompressed()) {
+    ws.outer.assign(w.outerIndexPtr(), w.outerIndexPtr() + m + 1);
+    ws.inner.assign(w.innerIndexPtr(), w.innerIndexPtr() + w.nonZeros());
+  }
 }
 
 }  // namespace

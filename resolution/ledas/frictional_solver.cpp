@@ -68,6 +68,11 @@ constexpr std::uint64_t kProjectionEntry = 4096;
 constexpr double kProjectionEntryFactor = 10.0;
 constexpr double kProjectionNewton = 1e7;
 constexpr double kProjectionNewtonFactor = 0.1;
+// The sticking guess (FrictionalSolver::sticking_guess): its answer counts as in the cones within this
+// fraction of its largest normal impulse, and gets at most this many Newton steps.
+constexpr double kGuessConeSlack = 1e-9;
+constexpr std::uint64_t kGuessNewtonSteps = 3;
+
 // Cadoux's fixed point (FrictionalSolver::solve, 2 and 4) stops when this many steps have not halved the
 // best residual of its iterates, or when twice as many have not brought it below the best before it.
 constexpr std::uint64_t kFixedPointStall = 3;
@@ -633,6 +638,7 @@ bool likely_redundant(const FrictionalProblem& problem) {
 void add(FrictionalStats& into, const FrictionalStats& part) {
   into.problems += part.problems;
   into.warm_started += part.warm_started;
+  into.sticking_guessed += part.sticking_guessed;
   into.relaxed += part.relaxed;
   into.slips_taken += part.slips_taken;
   into.releases += part.releases;
@@ -876,6 +882,16 @@ void FrictionalSolver::solve(const FrictionalProblem& problem, FrictionalStats& 
     }
     r.setZero();
   }
+  // 0b. A cold solve (no warm start): every contact sticking, W r = −q on every row at once (one
+  //     factorization, whose analysis the relaxation's interior point then shares). Where that answer
+  //     lies in the cones (a tower of planks, a stack of boxes standing), a few Newton steps finish it;
+  //     it is taken only if it solves the relaxation too, i.e. is the relaxation's answer.
+  if (!warm && !problem.convex && settings_.sticking_guess && sticking_guess(problem, r, stats)) {
+    ++stats.sticking_guessed;
+    residual = refine(problem, buffers_->blocks, r, natural_map_residual(problem, r), stats);
+    stats.residual = std::max(stats.residual, residual);
+    return;
+  }
   if (problem.convex) {
     if (warm) r = *problem.start;
     residual = solve_stages(problem, r, warm, stats);
@@ -1021,13 +1037,7 @@ void FrictionalSolver::solve(const FrictionalProblem& problem, FrictionalStats& 
     //    rounding, not just to the tolerance, and does not depend on which stage found it (a slope turned
     //    about its normal gives the same slip to 1e-12; the interior point's answer on the pyramid of
     //    K = 50 at rest goes from 1.4e-10 to 5e-13).
-    if (residual <= problem.tolerance && residual > 0.0) {
-      FrictionalProblem& exact = buffers.exact;
-      exact = problem;
-      exact.tolerance = 0.0;
-      steps_left_ = settings_.refinement_steps;
-      residual = newton(exact, blocks, r, settings_.refinement_steps, stats);
-    }
+    if (residual <= problem.tolerance) residual = refine(problem, blocks, r, residual, stats);
     // 7. Still not solved, on a small problem: one pressed contact released (release_one_contact).
     if (residual > problem.tolerance && blocks.size() <= settings_.release_max_contacts)
       residual = release_one_contact(problem, blocks, r, stats);
@@ -1258,6 +1268,67 @@ double FrictionalSolver::release_one_contact(const FrictionalProblem& problem, c
 
 // The stages (file comment) on `problem` from r, which they overwrite with the best iterate met; returns
 // its natural-map residual.
+// A few Newton steps past the tolerance from an answer r within it (`residual`): near a solution they
+// converge quadratically, so the answer is exact to rounding. Returns the new residual.
+double FrictionalSolver::refine(const FrictionalProblem& problem, const std::vector<Block>& blocks, Vector& r,
+                                double residual, FrictionalStats& stats) {
+  if (residual == 0.0) return residual;
+  FrictionalProblem& exact = buffers_->exact;
+  exact = problem;
+  exact.tolerance = 0.0;
+  steps_left_ = settings_.refinement_steps;
+  return newton(exact, blocks, r, settings_.refinement_steps, stats);
+}
+
+// Every contact sticking (and every frictionless contact and joint row pressed): one Newton step from
+// r = 0 with every block linearized on its active piece, i.e. (W + shift I) r = −q, the proximal
+// solution nearest 0. Its answer is a static equilibrium if it lies in the cones; then at most
+// kGuessNewtonSteps Newton steps on Coulomb's problem, and r is kept (true) only if it solves both
+// Coulomb's problem and the relaxation to the tolerance: the relaxation's velocities are unique, so it
+// is the relaxation's answer, the one the cold path would give. Else r = 0 (false).
+bool FrictionalSolver::sticking_guess(const FrictionalProblem& problem, Vector& r, FrictionalStats& stats) {
+  FrictionalWorkspace::Newton& buffers = *buffers_;
+  const Eigen::Index m = problem.q.size();
+  if (m == 0) return false;
+  buffers.diagonal = problem.w->diagonal();
+  make_blocks(problem, buffers.diagonal, buffers.blocks);
+  const std::vector<Block>& blocks = buffers.blocks;
+  buffers.lin.assign(blocks.size(), Linearization{});
+  for (Linearization& l : buffers.lin) l.piece = Piece::active;
+  buffers.f.resize(m);
+  for (const Block& b : blocks)  // F on the active piece at r = 0: ρ u = ρ q
+    for (int j = 0; j < b.size; ++j) buffers.f(b.first + j) = (j == 0 ? b.rho_n : b.rho_t) * problem.q(b.first + j);
+  const double shift = settings_.regularization * buffers.diagonal.maxCoeff();
+  ++stats.newton_steps;
+  if (!symmetric_direction(blocks, buffers.lin, *problem.w, shift, buffers.f, buffers, buffers.d)) {
+    r.setZero(m);
+    return false;
+  }
+  r = buffers.d;
+  // In the cones, up to rounding (Newton's steps take it the rest of the way).
+  double largest = 0.0;
+  for (const Block& b : blocks)
+    if (b.role != RowRole::equality) largest = std::max(largest, r(b.first));
+  const double slack = kGuessConeSlack * largest;
+  const bool in_cones = std::all_of(blocks.begin(), blocks.end(), [&](const Block& b) {
+    if (b.role == RowRole::equality) return true;
+    if (r(b.first) < -slack) return false;
+    return b.size == 1 || std::hypot(r(b.first + 1), r(b.first + 2)) <= b.mu * r(b.first) + slack;
+  });
+  if (in_cones) {
+    steps_left_ = kGuessNewtonSteps;
+    if (newton(problem, blocks, r, kGuessNewtonSteps, stats) <= problem.tolerance) {
+      FrictionalProblem& relaxed = buffers.relaxed;
+      relaxed = problem;
+      relaxed.convex = true;
+      relaxed.start = nullptr;
+      if (natural_map_residual(relaxed, r) <= relaxed.tolerance) return true;
+    }
+  }
+  r.setZero(m);
+  return false;
+}
+
 double FrictionalSolver::solve_stages(const FrictionalProblem& problem, Vector& r, bool warm, FrictionalStats& stats) {
   const SparseMatrix& w = *problem.w;
   FrictionalWorkspace::Newton& buffers = *buffers_;

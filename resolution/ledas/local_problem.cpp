@@ -47,6 +47,37 @@ void check(const LocalContactProblem& p) {
       throw std::invalid_argument("mu of contact " + std::to_string(c) + " is " + std::to_string(p.mu[c]) + " (must be finite and ≥ 0)");
 }
 
+// W, checked symmetric to kSymmetryTolerance and made exactly symmetric: ½ (W + Wᵀ), its columns'
+// entries sorted. A structurally symmetric W (the usual case) is averaged entry by entry on its own
+// pattern; any other is formed as a sum.
+SparseMatrix symmetrized(const Eigen::Map<const Eigen::SparseMatrix<double, Eigen::ColMajor, std::int32_t>>& w_file) {
+  const SparseMatrix transpose = w_file.transpose();
+  const std::int32_t* outer = w_file.outerIndexPtr();
+  const std::int32_t* inner = w_file.innerIndexPtr();
+  bool sorted = true;  // each column's rows strictly increasing (as fclib's writers and Impetus's store them)
+  for (Eigen::Index j = 0; j < w_file.cols() && sorted; ++j)
+    for (std::int32_t p = outer[j] + 1; p < outer[j + 1] && sorted; ++p) sorted = inner[p - 1] < inner[p];
+  SparseMatrix w = sorted ? SparseMatrix(w_file) : SparseMatrix(transpose.transpose());
+  const double scale = w.nonZeros() > 0 ? w.coeffs().cwiseAbs().maxCoeff() : 0.0;
+  const auto m = static_cast<std::size_t>(w.cols());
+  const auto nonzeros = static_cast<std::size_t>(w.nonZeros());
+  if (w.nonZeros() == transpose.nonZeros() &&
+      std::equal(w.outerIndexPtr(), w.outerIndexPtr() + m + 1, transpose.outerIndexPtr()) &&
+      std::equal(w.innerIndexPtr(), w.innerIndexPtr() + nonzeros, transpose.innerIndexPtr())) {
+    double* value = w.valuePtr();
+    const double* mirror = transpose.valuePtr();
+    for (std::size_t k = 0; k < nonzeros; ++k) {
+      if (std::abs(value[k] - mirror[k]) > kSymmetryTolerance * scale) throw std::invalid_argument("W is not symmetric");
+      value[k] = 0.5 * (value[k] + mirror[k]);
+    }
+    return w;
+  }
+  const SparseMatrix difference = w - transpose;
+  if (difference.nonZeros() > 0 && difference.coeffs().cwiseAbs().maxCoeff() > kSymmetryTolerance * scale)
+    throw std::invalid_argument("W is not symmetric");
+  return 0.5 * (w + transpose);
+}
+
 }  // namespace
 
 void solve_local_problem(FrictionalSolver& solver, const LocalContactProblem& p, LocalContactSolution& s,
@@ -56,13 +87,7 @@ void solve_local_problem(FrictionalSolver& solver, const LocalContactProblem& p,
   if (m > 0 && (!s.r || !s.u)) throw std::invalid_argument("the solution's arrays are missing");
   const Eigen::Map<const Eigen::SparseMatrix<double, Eigen::ColMajor, std::int32_t>> w_file(
       m, m, m > 0 ? p.w_columns[m] : 0, p.w_columns, p.w_rows, p.w_values);
-  const SparseMatrix w_full = w_file;
-  const SparseMatrix transpose = w_full.transpose();
-  const SparseMatrix difference = w_full - transpose;
-  const double scale = w_full.nonZeros() > 0 ? w_full.coeffs().cwiseAbs().maxCoeff() : 0.0;
-  if (difference.nonZeros() > 0 && difference.coeffs().cwiseAbs().maxCoeff() > kSymmetryTolerance * scale)
-    throw std::invalid_argument("W is not symmetric");
-  const SparseMatrix w = 0.5 * (w_full + transpose);
+  const SparseMatrix w = symmetrized(w_file);
   const Eigen::Map<const Vector> q_full(p.q, m);
 
   // The solver's rows: a contact's normal row, its tangent rows only if μ > 0 (with μ = 0 the cone forces
@@ -84,17 +109,20 @@ void solve_local_problem(FrictionalSolver& solver, const LocalContactProblem& p,
     problem.mu.push_back(0.0);
   }
   const auto n = static_cast<Eigen::Index>(kept.size());
-  std::vector<Eigen::Index> slot(static_cast<std::size_t>(m), -1);
-  for (Eigen::Index k = 0; k < n; ++k) slot[static_cast<std::size_t>(kept[static_cast<std::size_t>(k)])] = k;
-  std::vector<Eigen::Triplet<double>> entries;
-  entries.reserve(static_cast<std::size_t>(w.nonZeros()));
-  for (Eigen::Index j = 0; j < m; ++j)
-    for (SparseMatrix::InnerIterator it(w, j); it; ++it)
-      if (const Eigen::Index a = slot[static_cast<std::size_t>(it.row())], b = slot[static_cast<std::size_t>(j)]; a >= 0 && b >= 0)
-        entries.emplace_back(a, b, it.value());
-  SparseMatrix reduced(n, n);
-  reduced.setFromTriplets(entries.begin(), entries.end());
-  problem.w = &reduced;
+  SparseMatrix reduced;  // W on the kept rows, when some are dropped
+  if (n < m) {
+    std::vector<Eigen::Index> slot(static_cast<std::size_t>(m), -1);
+    for (Eigen::Index k = 0; k < n; ++k) slot[static_cast<std::size_t>(kept[static_cast<std::size_t>(k)])] = k;
+    std::vector<Eigen::Triplet<double>> entries;
+    entries.reserve(static_cast<std::size_t>(w.nonZeros()));
+    for (Eigen::Index j = 0; j < m; ++j)
+      for (SparseMatrix::InnerIterator it(w, j); it; ++it)
+        if (const Eigen::Index a = slot[static_cast<std::size_t>(it.row())], b = slot[static_cast<std::size_t>(j)]; a >= 0 && b >= 0)
+          entries.emplace_back(a, b, it.value());
+    reduced.resize(n, n);
+    reduced.setFromTriplets(entries.begin(), entries.end());
+  }
+  problem.w = n < m ? &reduced : &w;
   problem.q.resize(n);
   for (Eigen::Index k = 0; k < n; ++k) problem.q(k) = q_full(kept[static_cast<std::size_t>(k)]);
   problem.tolerance = p.tolerance;

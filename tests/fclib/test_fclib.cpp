@@ -488,4 +488,70 @@ TEST(Fclib, ProjectionSolvesTheDroppedPyramidK20) {
   expect_coulomb_with_slip(problem, r, u, tolerance);
 }
 
+// A standing stack of 40 boxes, each on four corners (160 contacts, μ = 0.5), given one step of gravity:
+// every contact can stick, so W r = −q on every row at once (the sticking guess, one factorization) has
+// an answer in the cones, and Newton finishes it without the interior point. Checked against Coulomb's
+// law (every pressed contact sticks: u = 0, r in its cone) and against the relaxation's answer from the
+// interior point, whose velocities are unique.
+TEST(Fclib, TheStickingGuessSolvesAStandingStackWithoutTheInteriorPoint) {
+  PluginHost host;
+  const Case c{"accuracy_box_stack_40.yaml", {}, [](std::span<RigidBody> bodies) {
+                 for (RigidBody& b : bodies) b.material.friction = 0.5;
+                 gravity_kick(1.0 / 60.0)(bodies);
+               }};
+  const fclib::LocalProblem problem = detected_problem(c, host).local;
+  ASSERT_EQ(problem.contacts(), 160u);
+  const double tolerance = 1e-10 * problem.q.norm();
+  std::vector<double> r(problem.rows()), u(problem.rows()), r_relaxed(problem.rows()), u_relaxed(problem.rows());
+  LocalContactSolution solution{r.data(), u.data()}, relaxed_solution{r_relaxed.data(), u_relaxed.data()};
+  ledas::FrictionalSolver solver;
+  ledas::FrictionalStats stats;
+  ledas::solve_local_problem(solver, problem.view(tolerance), solution, stats);
+  EXPECT_TRUE(solution.converged);
+  EXPECT_EQ(stats.sticking_guessed, 1u);
+  EXPECT_EQ(stats.relaxed, 0u);
+  EXPECT_EQ(stats.interior_point_steps, 0u);
+  for (std::size_t k = 0; k < problem.contacts(); ++k) {
+    const Eigen::Vector3d rk(r[3 * k], r[3 * k + 1], r[3 * k + 2]), uk(u[3 * k], u[3 * k + 1], u[3 * k + 2]);
+    EXPECT_GE(rk(0), 0.0) << k;
+    EXPECT_LE(rk.tail<2>().norm(), problem.mu[k] * rk(0) + tolerance) << k;
+    EXPECT_LE(uk.norm(), tolerance) << k;  // sticking (or touching with no impulse)
+  }
+
+  ledas::FrictionalSettings without;
+  without.sticking_guess = false;
+  ledas::FrictionalSolver interior(without);
+  ledas::FrictionalStats interior_stats;
+  ledas::solve_local_problem(interior, problem.view(tolerance), relaxed_solution, interior_stats);
+  EXPECT_TRUE(relaxed_solution.converged);
+  EXPECT_EQ(interior_stats.sticking_guessed, 0u);
+  EXPECT_GT(interior_stats.interior_point_steps, 0u);
+  for (std::size_t i = 0; i < problem.rows(); ++i) EXPECT_NEAR(u[i], u_relaxed[i], 2.0 * tolerance) << i;
+}
+
+// The dropped sphere pyramid K = 10 at μ = 0.7: every contact can stick, but W r = −q's answer nearest 0
+// pulls at some contacts and leaves the cone at others, so the guess is refused and the interior point
+// finds the static equilibrium.
+TEST(Fclib, TheStickingGuessIsRefusedWhereItLeavesTheCones) {
+  PluginHost host;
+  const Case c{"pyramid_drop_10.yaml", {"generators.0.pyramid.friction=0.7"}, nullptr};
+  const fclib::LocalProblem problem = detected_problem(c, host).local;
+  ASSERT_EQ(problem.contacts(), 145u);
+  const double tolerance = 1e-10 * problem.q.norm();
+  std::vector<double> r(problem.rows()), u(problem.rows());
+  LocalContactSolution solution{r.data(), u.data()};
+  ledas::FrictionalSolver solver;
+  ledas::FrictionalStats stats;
+  ledas::solve_local_problem(solver, problem.view(tolerance), solution, stats);
+  EXPECT_TRUE(solution.converged);
+  EXPECT_EQ(stats.sticking_guessed, 0u);
+  EXPECT_GT(stats.interior_point_steps, 0u);
+  for (std::size_t k = 0; k < problem.contacts(); ++k) {
+    EXPECT_LE(std::hypot(r[3 * k + 1], r[3 * k + 2]), problem.mu[k] * r[3 * k] + tolerance) << k;
+    if (r[3 * k] > 1e-9) {
+      EXPECT_LE(std::hypot(u[3 * k], std::hypot(u[3 * k + 1], u[3 * k + 2])), tolerance) << k;
+    }
+  }
+}
+
 }  // namespace
