@@ -153,6 +153,16 @@ struct FrictionalWorkspace::Newton {
   Vector relaxation_first;   // the first relaxation's answer (the projection stage starts from it)
 };
 
+void FrictionalWorkspace::forget_analyses() {
+  if (!newton) return;
+  newton->ldlt.forget_pattern();
+  newton->analysed_outer.clear();  // KLU's ordering and the Jacobian's pattern
+  newton->analysed_inner.clear();
+  newton->cone_qp.outer.clear();  // the interior point's pattern
+  newton->cone_qp.inner.clear();
+  newton->factored_number = 0;
+}
+
 FrictionalWorkspace::FrictionalWorkspace() = default;
 FrictionalWorkspace::~FrictionalWorkspace() = default;
 FrictionalWorkspace::FrictionalWorkspace(FrictionalWorkspace&&) noexcept = default;

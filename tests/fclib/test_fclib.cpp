@@ -554,4 +554,28 @@ TEST(Fclib, TheStickingGuessIsRefusedWhereItLeavesTheCones) {
   }
 }
 
+// A solver keeps its storage between local problems but analyses each afresh: a problem solved after
+// others gives the bits it gives on a new solver, and the same problem twice in a row too.
+TEST(Fclib, ALocalProblemGivesTheSameBitsAfterOthers) {
+  PluginHost host;
+  const std::vector<Case> all = cases();
+  std::vector<fclib::LocalProblem> problems;
+  for (const Case& c : all) problems.push_back(detected_problem(c, host).local);
+  const auto solve = [](ledas::FrictionalSolver& solver, const fclib::LocalProblem& problem) {
+    std::vector<double> r(problem.rows()), u(problem.rows());
+    LocalContactSolution solution{r.data(), u.data()};
+    ledas::FrictionalStats stats;
+    ledas::solve_local_problem(solver, problem.view(1e-10 * (1.0 + problem.q.norm())), solution, stats);
+    EXPECT_TRUE(solution.converged);
+    return r;
+  };
+  ledas::FrictionalSolver shared;
+  for (std::size_t i = 0; i < problems.size(); ++i) {
+    ledas::FrictionalSolver fresh;
+    const std::vector<double> alone = solve(fresh, problems[i]);
+    EXPECT_EQ(solve(shared, problems[i]), alone) << label(all[i]);
+    EXPECT_EQ(solve(shared, problems[i]), alone) << label(all[i]) << ", again";
+  }
+}
+
 }  // namespace

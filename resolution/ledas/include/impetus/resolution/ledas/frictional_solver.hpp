@@ -70,6 +70,10 @@ struct FrictionalWorkspace {
   Vector u;  ///< u = W r + q of the natural-map residual
   struct Newton;  ///< the Newton steps' buffers (frictional_solver.cpp)
   std::unique_ptr<Newton> newton;
+  /// Forgets every analysis of a pattern (orderings, symbolic factorizations) while keeping the
+  /// storage: the next solve analyses afresh, as a solve with a new workspace would, in memory already
+  /// held.
+  void forget_analyses();
 };
 
 /// One island's frictional contact problem.
@@ -205,6 +209,9 @@ class FrictionalSolver {
   void solve(const FrictionalProblem& problem, FrictionalStats& stats, Vector& r);
 
   const FrictionalSettings& settings() const { return settings_; }
+  /// The workspace of problems solved one by one (solve_local_problem), kept between them for its
+  /// storage only: each of those solves forgets its analyses first.
+  FrictionalWorkspace& local_workspace() { return local_workspace_; }
 
   struct Block;  // one contact's rows (frictional_solver.cpp)
 
@@ -225,6 +232,7 @@ class FrictionalSolver {
                              FrictionalStats& stats);
 
   FrictionalSettings settings_;
+  FrictionalWorkspace local_workspace_;
   std::uint64_t steps_left_ = 0;  // Newton steps left to the current solve (max_newton_steps)
   FrictionalWorkspace::Newton* buffers_ = nullptr;  // the current solve's Newton buffers
 };

@@ -95,6 +95,11 @@ class MaskedLdlt {
   bool analysed(std::size_t k) const { return analysed_[static_cast<SparseIndex>(k)] != 0; }
   /// Whether `a` has the pattern analyze() was given.
   bool same_pattern(const Matrix& a) const;
+  /// Forgets that pattern (same_pattern() is false until the next analyze()), keeping the storage.
+  void forget_pattern() {
+    outer_.clear();
+    inner_.clear();
+  }
 
   /// Numeric factorization of A_FF, F = {k : on[k] != 0} (rows analysed: covers(on)); returns the number
   /// of dropped rows (see the file comment). A row with A_kk ≤ floor (nothing movable behind it) is dropped too.
