@@ -1276,8 +1276,6 @@ double FrictionalSolver::release_one_contact(const FrictionalProblem& problem, c
   return natural_map_residual(problem, r);
 }
 
-// The stages (file comment) on `problem` from r, which they overwrite with the best iterate met; returns
-// its natural-map residual.
 // A few Newton steps past the tolerance from an answer r within it (`residual`): near a solution they
 // converge quadratically, so the answer is exact to rounding. Returns the new residual.
 double FrictionalSolver::refine(const FrictionalProblem& problem, const std::vector<Block>& blocks, Vector& r,
@@ -1339,6 +1337,8 @@ bool FrictionalSolver::sticking_guess(const FrictionalProblem& problem, Vector& 
   return false;
 }
 
+// The stages (file comment) on `problem` from r, which they overwrite with the best iterate met; returns
+// its natural-map residual.
 double FrictionalSolver::solve_stages(const FrictionalProblem& problem, Vector& r, bool warm, FrictionalStats& stats) {
   const SparseMatrix& w = *problem.w;
   FrictionalWorkspace::Newton& buffers = *buffers_;

@@ -15,6 +15,9 @@
 ///  0. a warm start, if given: taken if it solves the problem, else polished by a few Newton steps, then
 ///     by more whose answer is taken if it sticks, or if it slips and the relaxation (1) has no static
 ///     equilibrium;
+///  0b. without a warm start, every contact sticking (`sticking_guess`): W r = −q on every row, taken
+///     if it lies in the cones and, after a few Newton steps, solves both Coulomb's problem and the
+///     relaxation (so it is the relaxation's answer);
 ///  1. the convex relaxation (`convex`), solved by an interior-point method (cone_qp.hpp) and polished by
 ///     Newton on its natural map: a static equilibrium is its answer whenever one exists, and where its
 ///     answer has no pressed contact slipping it is Coulomb's answer;
