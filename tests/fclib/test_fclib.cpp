@@ -488,6 +488,23 @@ TEST(Fclib, ProjectionSolvesTheDroppedPyramidK20) {
   expect_coulomb_with_slip(problem, r, u, tolerance);
 }
 
+// A local problem solved by `solver` to `tolerance`: r, u = W r + q, and what the solve reports.
+struct LocalAnswer {
+  std::vector<double> r, u;
+  bool converged = false;
+  ledas::FrictionalStats stats;
+};
+
+LocalAnswer solve_local(ledas::FrictionalSolver& solver, const fclib::LocalProblem& problem, double tolerance) {
+  LocalAnswer answer;
+  answer.r.resize(problem.rows());
+  answer.u.resize(problem.rows());
+  LocalContactSolution solution{answer.r.data(), answer.u.data()};
+  ledas::solve_local_problem(solver, problem.view(tolerance), solution, answer.stats);
+  answer.converged = solution.converged;
+  return answer;
+}
+
 // A standing stack of 40 boxes, each on four corners (160 contacts, μ = 0.5), given one step of gravity:
 // every contact can stick, so W r = −q on every row at once (the sticking guess, one factorization) has
 // an answer in the cones, and Newton finishes it without the interior point. Checked against Coulomb's
@@ -502,17 +519,15 @@ TEST(Fclib, TheStickingGuessSolvesAStandingStackWithoutTheInteriorPoint) {
   const fclib::LocalProblem problem = detected_problem(c, host).local;
   ASSERT_EQ(problem.contacts(), 160u);
   const double tolerance = 1e-10 * problem.q.norm();
-  std::vector<double> r(problem.rows()), u(problem.rows()), r_relaxed(problem.rows()), u_relaxed(problem.rows());
-  LocalContactSolution solution{r.data(), u.data()}, relaxed_solution{r_relaxed.data(), u_relaxed.data()};
   ledas::FrictionalSolver solver;
-  ledas::FrictionalStats stats;
-  ledas::solve_local_problem(solver, problem.view(tolerance), solution, stats);
-  EXPECT_TRUE(solution.converged);
-  EXPECT_EQ(stats.sticking_guessed, 1u);
-  EXPECT_EQ(stats.relaxed, 0u);
-  EXPECT_EQ(stats.interior_point_steps, 0u);
+  const LocalAnswer guessed = solve_local(solver, problem, tolerance);
+  EXPECT_TRUE(guessed.converged);
+  EXPECT_EQ(guessed.stats.sticking_guessed, 1u);
+  EXPECT_EQ(guessed.stats.relaxed, 0u);
+  EXPECT_EQ(guessed.stats.interior_point_steps, 0u);
   for (std::size_t k = 0; k < problem.contacts(); ++k) {
-    const Eigen::Vector3d rk(r[3 * k], r[3 * k + 1], r[3 * k + 2]), uk(u[3 * k], u[3 * k + 1], u[3 * k + 2]);
+    const Eigen::Vector3d rk(guessed.r[3 * k], guessed.r[3 * k + 1], guessed.r[3 * k + 2]);
+    const Eigen::Vector3d uk(guessed.u[3 * k], guessed.u[3 * k + 1], guessed.u[3 * k + 2]);
     EXPECT_GE(rk(0), 0.0) << k;
     EXPECT_LE(rk.tail<2>().norm(), problem.mu[k] * rk(0) + tolerance) << k;
     EXPECT_LE(uk.norm(), tolerance) << k;  // sticking (or touching with no impulse)
@@ -521,12 +536,11 @@ TEST(Fclib, TheStickingGuessSolvesAStandingStackWithoutTheInteriorPoint) {
   ledas::FrictionalSettings without;
   without.sticking_guess = false;
   ledas::FrictionalSolver interior(without);
-  ledas::FrictionalStats interior_stats;
-  ledas::solve_local_problem(interior, problem.view(tolerance), relaxed_solution, interior_stats);
-  EXPECT_TRUE(relaxed_solution.converged);
-  EXPECT_EQ(interior_stats.sticking_guessed, 0u);
-  EXPECT_GT(interior_stats.interior_point_steps, 0u);
-  for (std::size_t i = 0; i < problem.rows(); ++i) EXPECT_NEAR(u[i], u_relaxed[i], 2.0 * tolerance) << i;
+  const LocalAnswer relaxed = solve_local(interior, problem, tolerance);
+  EXPECT_TRUE(relaxed.converged);
+  EXPECT_EQ(relaxed.stats.sticking_guessed, 0u);
+  EXPECT_GT(relaxed.stats.interior_point_steps, 0u);
+  for (std::size_t i = 0; i < problem.rows(); ++i) EXPECT_NEAR(guessed.u[i], relaxed.u[i], 2.0 * tolerance) << i;
 }
 
 // The dropped sphere pyramid K = 10 at μ = 0.7: every contact can stick, but W r = −q's answer nearest 0
@@ -538,18 +552,15 @@ TEST(Fclib, TheStickingGuessIsRefusedWhereItLeavesTheCones) {
   const fclib::LocalProblem problem = detected_problem(c, host).local;
   ASSERT_EQ(problem.contacts(), 145u);
   const double tolerance = 1e-10 * problem.q.norm();
-  std::vector<double> r(problem.rows()), u(problem.rows());
-  LocalContactSolution solution{r.data(), u.data()};
   ledas::FrictionalSolver solver;
-  ledas::FrictionalStats stats;
-  ledas::solve_local_problem(solver, problem.view(tolerance), solution, stats);
-  EXPECT_TRUE(solution.converged);
-  EXPECT_EQ(stats.sticking_guessed, 0u);
-  EXPECT_GT(stats.interior_point_steps, 0u);
+  const LocalAnswer a = solve_local(solver, problem, tolerance);
+  EXPECT_TRUE(a.converged);
+  EXPECT_EQ(a.stats.sticking_guessed, 0u);
+  EXPECT_GT(a.stats.interior_point_steps, 0u);
   for (std::size_t k = 0; k < problem.contacts(); ++k) {
-    EXPECT_LE(std::hypot(r[3 * k + 1], r[3 * k + 2]), problem.mu[k] * r[3 * k] + tolerance) << k;
-    if (r[3 * k] > 1e-9) {
-      EXPECT_LE(std::hypot(u[3 * k], std::hypot(u[3 * k + 1], u[3 * k + 2])), tolerance) << k;
+    EXPECT_LE(std::hypot(a.r[3 * k + 1], a.r[3 * k + 2]), problem.mu[k] * a.r[3 * k] + tolerance) << k;
+    if (a.r[3 * k] > 1e-9) {
+      EXPECT_LE(std::hypot(a.u[3 * k], std::hypot(a.u[3 * k + 1], a.u[3 * k + 2])), tolerance) << k;
     }
   }
 }
@@ -559,22 +570,15 @@ TEST(Fclib, TheStickingGuessIsRefusedWhereItLeavesTheCones) {
 TEST(Fclib, ALocalProblemGivesTheSameBitsAfterOthers) {
   PluginHost host;
   const std::vector<Case> all = cases();
-  std::vector<fclib::LocalProblem> problems;
-  for (const Case& c : all) problems.push_back(detected_problem(c, host).local);
-  const auto solve = [](ledas::FrictionalSolver& solver, const fclib::LocalProblem& problem) {
-    std::vector<double> r(problem.rows()), u(problem.rows());
-    LocalContactSolution solution{r.data(), u.data()};
-    ledas::FrictionalStats stats;
-    ledas::solve_local_problem(solver, problem.view(1e-10 * (1.0 + problem.q.norm())), solution, stats);
-    EXPECT_TRUE(solution.converged);
-    return r;
-  };
   ledas::FrictionalSolver shared;
-  for (std::size_t i = 0; i < problems.size(); ++i) {
+  for (const Case& c : all) {
+    const fclib::LocalProblem problem = detected_problem(c, host).local;
+    const double tolerance = 1e-10 * (1.0 + problem.q.norm());
     ledas::FrictionalSolver fresh;
-    const std::vector<double> alone = solve(fresh, problems[i]);
-    EXPECT_EQ(solve(shared, problems[i]), alone) << label(all[i]);
-    EXPECT_EQ(solve(shared, problems[i]), alone) << label(all[i]) << ", again";
+    const LocalAnswer alone = solve_local(fresh, problem, tolerance);
+    EXPECT_TRUE(alone.converged) << label(c);
+    EXPECT_EQ(solve_local(shared, problem, tolerance).r, alone.r) << label(c);
+    EXPECT_EQ(solve_local(shared, problem, tolerance).r, alone.r) << label(c) << ", again";
   }
 }
 
