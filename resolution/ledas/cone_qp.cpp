@@ -10,10 +10,10 @@
 #include "cone_qp.hpp"
 
 #include <algorithm>
-#include <numeric>
 #include <cassert>
 #include <cmath>
 #include <limits>
+#include <numeric>
 #include <vector>
 
 namespace impetus::ledas {
