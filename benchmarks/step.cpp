@@ -220,6 +220,7 @@ void dynamic_step(benchmark::State& state, const std::string& resolver_name, con
     state.counters["slips_taken"] = per_step(static_cast<double>(friction.slips_taken));
     state.counters["releases"] = per_step(static_cast<double>(friction.releases));
     state.counters["relaxed"] = per_step(static_cast<double>(friction.relaxed));
+    state.counters["warm_relaxed"] = per_step(static_cast<double>(friction.warm_relaxed));
     state.counters["newton_steps"] = per_step(static_cast<double>(friction.newton_steps));
     state.counters["newton_reused"] = per_step(static_cast<double>(friction.newton_reused));
     state.counters["interior_point_steps"] = per_step(static_cast<double>(friction.interior_point_steps));

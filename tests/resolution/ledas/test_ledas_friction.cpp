@@ -383,10 +383,12 @@ TEST(LedasFriction, SolvingIntoAVectorMatchesTheReturnedSolution) {
 //    impulses halved and the tangential ones reversed: where the warm Newton steps reach a slipping
 //    answer although the relaxation finds a static equilibrium, the check declines and the relaxation's
 //    answer is taken, bit for bit the full path's, solving the problem to its tolerance.
-// One unchecked warm Newton step (the default 2 reach the pushed contact's answer before the check).
+// One unchecked warm Newton step (the default 2 reach the pushed contact's answer before the check), and
+// no Newton on the relaxation first (warm_relaxation: tested below), so that the interior point checks.
 TEST(LedasFriction, SlippingWarmAnswerIsTakenOnlyWhereNoStaticEquilibriumExists) {
   ledas::FrictionalSettings settings;
   settings.warm_newton_iterations = 1;
+  settings.warm_relaxation = false;
   ledas::FrictionalSettings full_settings = settings;
   full_settings.slip_check = false;
   {
@@ -428,6 +430,62 @@ TEST(LedasFriction, SlippingWarmAnswerIsTakenOnlyWhereNoStaticEquilibriumExists)
     if (checked_stats.slips_taken == 0 && checked_stats.interior_point_steps > full_stats.interior_point_steps) ++declined;
   }
   EXPECT_GE(declined, 10u);
+}
+
+// Newton on the relaxation from a warm start (warm_relaxation) decides the same as the interior point:
+//  - the pushed contact: its relaxation is solved by Newton from the slipping answer, without an interior
+//    point step, and the slipping answer r = (1, −0.5, 0) is taken (to 1e-12);
+//  - the sphere cluster's 20 draws above, warm-started as there: every problem solved to its tolerance,
+//    with and without it, and with the same velocities u = W r + q to 10× the tolerance (the relaxation's
+//    velocities are unique; its impulses need not be); most (≥ 10) solved by it, with fewer interior-point
+//    steps in all.
+TEST(LedasFriction, NewtonOnTheRelaxationFromAWarmStartDecidesAsTheInteriorPoint) {
+  ledas::FrictionalSettings settings;
+  settings.warm_newton_iterations = 1;
+  ledas::FrictionalSettings without = settings;
+  without.warm_relaxation = false;
+  {
+    const ledas::SparseMatrix w = Eigen::MatrixXd::Identity(3, 3).sparseView();
+    ledas::FrictionalProblem problem = one_pushed_contact(w);
+    ledas::Vector start(3);
+    start << 0.9, -0.4, 0.1;
+    problem.start = &start;
+    ledas::FrictionalSolver solver(settings);
+    ledas::FrictionalStats stats;
+    const ledas::Vector r = solver.solve(problem, stats);
+    EXPECT_EQ(stats.warm_relaxed, 1u);
+    EXPECT_EQ(stats.slips_taken, 1u);
+    EXPECT_EQ(stats.interior_point_steps, 0u);
+    EXPECT_EQ(stats.non_converged, 0u);
+    EXPECT_NEAR(r(0), 1.0, 1e-12);
+    EXPECT_NEAR(r(1), -0.5, 1e-12);
+    EXPECT_NEAR(r(2), 0.0, 1e-12);
+  }
+  std::mt19937_64 random(5);
+  SphereCluster cluster;
+  ledas::FrictionalStats with_stats, without_stats;
+  for (int trial = 0; trial < 20; ++trial) {
+    cluster.draw_velocities(random);
+    ledas::SparseMatrix w;
+    std::vector<resolution::ImpulseRow> rows;
+    ledas::FrictionalProblem problem = cluster.problem(std::vector<double>(SphereCluster::kContacts, 0.0), w, rows);
+    ledas::FrictionalSolver cold_solver;
+    ledas::FrictionalStats cold_stats;
+    ledas::Vector start = cold_solver.solve(problem, cold_stats);
+    for (Eigen::Index i = 0; i < start.size(); ++i) start(i) *= i % 3 == 0 ? 0.5 : -1.0;
+    problem.start = &start;
+    ledas::FrictionalSolver with_solver(settings), without_solver(without);
+    const ledas::Vector r = with_solver.solve(problem, with_stats);
+    const ledas::Vector reference = without_solver.solve(problem, without_stats);
+    EXPECT_LE(ledas::natural_map_residual(problem, r), problem.tolerance) << "draw " << trial;
+    const ledas::Vector u = w * r + problem.q, u_reference = w * reference + problem.q;
+    EXPECT_LE((u - u_reference).lpNorm<Eigen::Infinity>(), 10 * problem.tolerance) << "draw " << trial;
+  }
+  EXPECT_EQ(with_stats.non_converged, 0u);
+  EXPECT_EQ(without_stats.non_converged, 0u);
+  EXPECT_EQ(without_stats.warm_relaxed, 0u);
+  EXPECT_GE(with_stats.warm_relaxed, 10u);
+  EXPECT_LT(with_stats.interior_point_steps, without_stats.interior_point_steps);
 }
 
 // W (n × n) from its lower triangle by rows, as dumped problems are kept here.

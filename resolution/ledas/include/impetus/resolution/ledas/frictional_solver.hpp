@@ -14,7 +14,9 @@
 /// Method (resolution/ledas/README.md, "Friction"), in stages:
 ///  0. a warm start, if given: taken if it solves the problem, else polished by a few Newton steps, then
 ///     by more whose answer is taken if it sticks, or if it slips and the relaxation (1) has no static
-///     equilibrium;
+///     equilibrium; that relaxation, and the one the cold path starts from after a failed warm start,
+///     first by Newton from the slipping answer or the warm start (a few steps), by the interior point
+///     only where those do not solve it;
 ///  0b. without a warm start, every contact sticking (`sticking_guess`): W r = −q on every row, taken
 ///     if it lies in the cones and, after a few Newton steps, solves both Coulomb's problem and the
 ///     relaxation (so it is the relaxation's answer);
@@ -119,6 +121,10 @@ struct FrictionalSettings {
   /// whether the relaxation's iterate slips too (Coulomb's residual above 1e3 × that target: no static
   /// equilibrium exists), and if so take the answer without solving the relaxation to the tolerance.
   bool slip_check = true;
+  /// Where a warm start does not solve the problem (or reaches a slipping answer): first at most 12
+  /// Newton steps on the relaxation from the slipping answer or the warm start; where they solve it, its
+  /// answer decides the slip exactly and starts the cold path, and no interior point runs for it.
+  bool warm_relaxation = true;
   std::uint64_t refinement_steps = 3;           ///< Newton steps past the tolerance on a cold answer
   /// A cold problem (no warm start) is first tried with every contact sticking: W r = −q on every row,
   /// one factorization, and if that answer lies in the cones, 3 Newton steps; it is taken only if it
@@ -167,7 +173,11 @@ struct FrictionalStats {
   std::uint64_t warm_started = 0;      ///< problems solved from their warm start (`start`)
   std::uint64_t sticking_guessed = 0;  ///< cold problems solved by the sticking guess (sticking_guess)
   std::uint64_t relaxed = 0;           ///< Coulomb problems started from their convex relaxation
-  std::uint64_t slips_taken = 0;       ///< slipping warm answers taken after the loose check (slip_check)
+  /// of those, warm-started ones whose relaxation Newton solved from the warm start (no interior point)
+  std::uint64_t warm_relaxed = 0;
+  /// slipping warm answers taken where Newton's relaxation or the loose check (slip_check) showed that no
+  /// static equilibrium exists
+  std::uint64_t slips_taken = 0;
   std::uint64_t releases = 0;          ///< problems solved with one contact released (release_max_contacts)
   std::uint64_t fixed_point_steps = 0; ///< Cadoux's fixed-point steps
   std::uint64_t newton_steps = 0;      ///< Newton steps (one factorization each, but newton_reused)
@@ -221,6 +231,7 @@ class FrictionalSolver {
  private:
   double solve_stages(const FrictionalProblem& problem, Vector& r, bool warm, FrictionalStats& stats);
   bool sticking_guess(const FrictionalProblem& problem, Vector& r, FrictionalStats& stats);
+  double warm_relaxation(const FrictionalProblem& relaxed, Vector& r, FrictionalStats& stats);
   double refine(const FrictionalProblem& problem, const std::vector<Block>& blocks, Vector& r, double residual,
                 FrictionalStats& stats);
   double newton(const FrictionalProblem& problem, const std::vector<Block>& blocks, Vector& r,
