@@ -911,7 +911,7 @@ void FrictionalSolver::solve(const FrictionalProblem& problem, FrictionalStats& 
   }
   if (problem.convex) {
     if (warm) r = *problem.start;
-    residual = solve_stages(problem, r, warm, stats);
+    residual = solve_stages(problem, r, warm, stats, settings_.max_newton_steps);
   } else {
     // 1. The convex relaxation: among Coulomb's solutions of a redundant problem it picks the one a
     //    static equilibrium gives, whenever one exists (velocities 0 where the relaxation's are, see
@@ -956,7 +956,7 @@ void FrictionalSolver::solve(const FrictionalProblem& problem, FrictionalStats& 
       r = buffers_->warm_answer;
       residual = natural_map_residual(problem, r);
     } else {
-      if (!relaxation_solved) relaxed_residual = solve_stages(relaxed, r, false, stats);
+      if (!relaxation_solved) relaxed_residual = solve_stages(relaxed, r, false, stats, settings_.max_newton_steps);
       residual = natural_map_residual(problem, r);
       if (residual > problem.tolerance && warm_slips) {  // no static equilibrium: the warm start's answer
         if (relaxation_solved) ++stats.slips_taken;  // (counted as the loose check's are)
@@ -1004,7 +1004,7 @@ void FrictionalSolver::solve(const FrictionalProblem& problem, FrictionalStats& 
         relaxed.q = problem.q;
         for (const Block& block : blocks)
           if (block.size == 3) relaxed.q(block.first) += block.mu * std::hypot(u(block.first + 1), u(block.first + 2));
-        if (solve_stages(relaxed, from, false, stats) > relaxed.tolerance) return false;
+        if (solve_stages(relaxed, from, false, stats, settings_.max_newton_steps) > relaxed.tolerance) return false;
         const double relaxed_now = natural_map_residual(problem, from);
         own = std::min(own, relaxed_now);
         if (relaxed_now < best_residual) {
@@ -1022,7 +1022,10 @@ void FrictionalSolver::solve(const FrictionalProblem& problem, FrictionalStats& 
     r = best;
     residual = best_residual;
     // 3. Still not solved: the stages on Coulomb's problem from the best answer.
-    if (residual > problem.tolerance) residual = solve_stages(problem, r, true, stats);
+    //    On a problem that had a warm start (an island of a running scene), at most
+    //    `warm_stage_newton_steps` there: the stages after this one, or the next step, go on.
+    if (residual > problem.tolerance)
+      residual = solve_stages(problem, r, true, stats, warm ? settings_.warm_stage_newton_steps : settings_.max_newton_steps);
     // 4. Still not solved, on a problem of at most `fixed_point_rows` rows: Cadoux's fixed point goes on
     //    from the relaxation's last answer. Of 135 island problems of the frictional pile that the stages
     //    left unsolved (dumped from a run), it solves 114.
@@ -1375,13 +1378,14 @@ bool FrictionalSolver::sticking_guess(const FrictionalProblem& problem, Vector& 
 
 // The stages (file comment) on `problem` from r, which they overwrite with the best iterate met; returns
 // its natural-map residual.
-double FrictionalSolver::solve_stages(const FrictionalProblem& problem, Vector& r, bool warm, FrictionalStats& stats) {
+double FrictionalSolver::solve_stages(const FrictionalProblem& problem, Vector& r, bool warm, FrictionalStats& stats,
+                                      std::uint64_t max_steps) {
   const SparseMatrix& w = *problem.w;
   FrictionalWorkspace::Newton& buffers = *buffers_;
   const Vector& diagonal = buffers.stage_diagonal = w.diagonal();
   make_blocks(problem, diagonal, buffers.stage_blocks);
   const std::vector<Block>& blocks = buffers.stage_blocks;
-  steps_left_ = settings_.max_newton_steps;
+  steps_left_ = max_steps;
 
   // 1. Newton on the problem itself: enough whenever W is well conditioned on the contacts that end up
   //    pressed, or near a solution.
