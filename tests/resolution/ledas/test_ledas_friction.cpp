@@ -375,6 +375,44 @@ TEST(LedasFriction, SolvingIntoAVectorMatchesTheReturnedSolution) {
 }
 
 
+// The pushed contact (W = I), warm-started near its slipping answer r = (1, −0.5, 0).
+struct PushedContactWarmStarted {
+  PushedContactWarmStarted() : w(Eigen::MatrixXd::Identity(3, 3).sparseView()), problem(one_pushed_contact(w)) {
+    start << 0.9, -0.4, 0.1;
+    problem.start = &start;
+  }
+  PushedContactWarmStarted(const PushedContactWarmStarted&) = delete;  // problem points into it
+  static void expect_slipping_answer(const ledas::Vector& r) {
+    EXPECT_NEAR(r(0), 1.0, 1e-12);
+    EXPECT_NEAR(r(1), -0.5, 1e-12);
+    EXPECT_NEAR(r(2), 0.0, 1e-12);
+  }
+  PushedContactWarmStarted& operator=(const PushedContactWarmStarted&) = delete;
+  ledas::SparseMatrix w;
+  ledas::Vector start = ledas::Vector::Zero(3);
+  ledas::FrictionalProblem problem;
+};
+
+// The sphere cluster's next random draw, warm-started from its cold answer with the normal impulses
+// halved and the tangential ones reversed (a start its warm Newton steps can take to a slipping answer).
+struct WarmStartedDraw {
+  WarmStartedDraw(SphereCluster& cluster, std::mt19937_64& random) {
+    cluster.draw_velocities(random);
+    problem = cluster.problem(std::vector<double>(SphereCluster::kContacts, 0.0), w, rows);
+    ledas::FrictionalSolver cold_solver;
+    ledas::FrictionalStats cold_stats;
+    start = cold_solver.solve(problem, cold_stats);
+    for (Eigen::Index i = 0; i < start.size(); ++i) start(i) *= i % 3 == 0 ? 0.5 : -1.0;
+    problem.start = &start;
+  }
+  WarmStartedDraw(const WarmStartedDraw&) = delete;  // problem points into it
+  WarmStartedDraw& operator=(const WarmStartedDraw&) = delete;
+  ledas::SparseMatrix w;
+  std::vector<resolution::ImpulseRow> rows;
+  ledas::Vector start;
+  ledas::FrictionalProblem problem;
+};
+
 // A slipping answer Newton reaches from a warm start is taken after the loose interior-point check only
 // where no static equilibrium exists, and it is then what the full relaxation leads to as well:
 //  - the pushed contact above (its relaxation separates: no equilibrium), from (0.9, −0.4, 0.1): the
@@ -392,34 +430,22 @@ TEST(LedasFriction, SlippingWarmAnswerIsTakenOnlyWhereNoStaticEquilibriumExists)
   ledas::FrictionalSettings full_settings = settings;
   full_settings.slip_check = false;
   {
-    const ledas::SparseMatrix w = Eigen::MatrixXd::Identity(3, 3).sparseView();
-    ledas::FrictionalProblem problem = one_pushed_contact(w);
-    ledas::Vector start(3);
-    start << 0.9, -0.4, 0.1;
-    problem.start = &start;
+    PushedContactWarmStarted pushed;
+    ledas::FrictionalProblem& problem = pushed.problem;
     ledas::FrictionalSolver checked(settings), full(full_settings);
     ledas::FrictionalStats checked_stats, full_stats;
     const ledas::Vector r = checked.solve(problem, checked_stats);
     EXPECT_EQ(r, full.solve(problem, full_stats));
     EXPECT_EQ(checked_stats.slips_taken, 1u);
     EXPECT_EQ(checked_stats.non_converged, 0u);
-    EXPECT_NEAR(r(0), 1.0, 1e-12);
-    EXPECT_NEAR(r(1), -0.5, 1e-12);
-    EXPECT_NEAR(r(2), 0.0, 1e-12);
+    PushedContactWarmStarted::expect_slipping_answer(r);
   }
   std::mt19937_64 random(5);
   SphereCluster cluster;
   std::uint64_t declined = 0;
   for (int trial = 0; trial < 20; ++trial) {
-    cluster.draw_velocities(random);
-    ledas::SparseMatrix w;
-    std::vector<resolution::ImpulseRow> rows;
-    ledas::FrictionalProblem problem = cluster.problem(std::vector<double>(SphereCluster::kContacts, 0.0), w, rows);
-    ledas::FrictionalSolver cold_solver;
-    ledas::FrictionalStats cold_stats;
-    ledas::Vector start = cold_solver.solve(problem, cold_stats);
-    for (Eigen::Index i = 0; i < start.size(); ++i) start(i) *= i % 3 == 0 ? 0.5 : -1.0;
-    problem.start = &start;
+    WarmStartedDraw draw(cluster, random);
+    ledas::FrictionalProblem& problem = draw.problem;
     ledas::FrictionalSolver checked(settings), full(full_settings);
     ledas::FrictionalStats checked_stats, full_stats;
     const ledas::Vector r = checked.solve(problem, checked_stats);
@@ -445,11 +471,8 @@ TEST(LedasFriction, NewtonOnTheRelaxationFromAWarmStartDecidesAsTheInteriorPoint
   ledas::FrictionalSettings without = settings;
   without.warm_relaxation = false;
   {
-    const ledas::SparseMatrix w = Eigen::MatrixXd::Identity(3, 3).sparseView();
-    ledas::FrictionalProblem problem = one_pushed_contact(w);
-    ledas::Vector start(3);
-    start << 0.9, -0.4, 0.1;
-    problem.start = &start;
+    PushedContactWarmStarted pushed;
+    ledas::FrictionalProblem& problem = pushed.problem;
     ledas::FrictionalSolver solver(settings);
     ledas::FrictionalStats stats;
     const ledas::Vector r = solver.solve(problem, stats);
@@ -457,28 +480,19 @@ TEST(LedasFriction, NewtonOnTheRelaxationFromAWarmStartDecidesAsTheInteriorPoint
     EXPECT_EQ(stats.slips_taken, 1u);
     EXPECT_EQ(stats.interior_point_steps, 0u);
     EXPECT_EQ(stats.non_converged, 0u);
-    EXPECT_NEAR(r(0), 1.0, 1e-12);
-    EXPECT_NEAR(r(1), -0.5, 1e-12);
-    EXPECT_NEAR(r(2), 0.0, 1e-12);
+    PushedContactWarmStarted::expect_slipping_answer(r);
   }
   std::mt19937_64 random(5);
   SphereCluster cluster;
   ledas::FrictionalStats with_stats, without_stats;
   for (int trial = 0; trial < 20; ++trial) {
-    cluster.draw_velocities(random);
-    ledas::SparseMatrix w;
-    std::vector<resolution::ImpulseRow> rows;
-    ledas::FrictionalProblem problem = cluster.problem(std::vector<double>(SphereCluster::kContacts, 0.0), w, rows);
-    ledas::FrictionalSolver cold_solver;
-    ledas::FrictionalStats cold_stats;
-    ledas::Vector start = cold_solver.solve(problem, cold_stats);
-    for (Eigen::Index i = 0; i < start.size(); ++i) start(i) *= i % 3 == 0 ? 0.5 : -1.0;
-    problem.start = &start;
+    WarmStartedDraw draw(cluster, random);
+    ledas::FrictionalProblem& problem = draw.problem;
     ledas::FrictionalSolver with_solver(settings), without_solver(without);
     const ledas::Vector r = with_solver.solve(problem, with_stats);
     const ledas::Vector reference = without_solver.solve(problem, without_stats);
     EXPECT_LE(ledas::natural_map_residual(problem, r), problem.tolerance) << "draw " << trial;
-    const ledas::Vector u = w * r + problem.q, u_reference = w * reference + problem.q;
+    const ledas::Vector u = draw.w * r + problem.q, u_reference = draw.w * reference + problem.q;
     EXPECT_LE((u - u_reference).lpNorm<Eigen::Infinity>(), 10 * problem.tolerance) << "draw " << trial;
   }
   EXPECT_EQ(with_stats.non_converged, 0u);
