@@ -486,6 +486,21 @@ TEST(Fclib, ProjectionSolvesTheDroppedPyramidK20) {
   EXPECT_GT(stats.projection_iterations, 0u);
   EXPECT_EQ(stats.nonsmooth_sweeps, 0u);
   expect_coulomb_with_slip(problem, r, u, tolerance);
+
+  // The Newton stages before the projection get projection_stage_newton_steps (50) of their 300 steps:
+  // with all 300 (the order before 2026-12-07) they fail as well, and the projection, started from the
+  // relaxation's answer either way, reaches the same answer. At least 200 Newton steps fewer.
+  ledas::FrictionalSettings all_first;
+  all_first.projection_stage_newton_steps = all_first.max_newton_steps;
+  ledas::FrictionalSolver before(all_first);
+  std::vector<double> r_before(problem.rows()), u_before(problem.rows());
+  LocalContactSolution solution_before{r_before.data(), u_before.data()};
+  ledas::FrictionalStats stats_before;
+  ledas::solve_local_problem(before, problem.view(tolerance), solution_before, stats_before);
+  EXPECT_TRUE(solution_before.converged);
+  EXPECT_EQ(stats_before.projection_solved, 1u);
+  EXPECT_LE(stats.newton_steps + 200, stats_before.newton_steps);
+  for (std::size_t k = 0; k < u.size(); ++k) EXPECT_NEAR(u[k], u_before[k], 10 * tolerance) << "row " << k;
 }
 
 // A local problem solved by `solver` to `tolerance`: r, u = W r + q, and what the solve reports.
