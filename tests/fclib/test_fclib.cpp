@@ -488,7 +488,7 @@ TEST(Fclib, ProjectionSolvesTheDroppedPyramidK20) {
   expect_coulomb_with_slip(problem, r, u, tolerance);
 
   // The Newton stages before the projection get projection_stage_newton_steps (50) of their 300 steps:
-  // with all 300 (the order before 2026-12-07) they fail as well, and the projection, started from the
+  // with all 300 (the order until 2026-12-06, night) they fail as well, and the projection, started from the
   // relaxation's answer either way, reaches the same answer. At least 200 Newton steps fewer.
   ledas::FrictionalSettings all_first;
   all_first.projection_stage_newton_steps = all_first.max_newton_steps;
