@@ -463,6 +463,23 @@ TEST(Fclib, NonsmoothGaussSeidelSolvesWhereTheNewtonStagesStall) {
   expect_coulomb_with_slip(problem, r, u, tolerance);
 }
 
+// A local problem solved by `solver` to `tolerance`: r, u = W r + q, and what the solve reports.
+struct LocalAnswer {
+  std::vector<double> r, u;
+  bool converged = false;
+  ledas::FrictionalStats stats;
+};
+
+LocalAnswer solve_local(ledas::FrictionalSolver& solver, const fclib::LocalProblem& problem, double tolerance) {
+  LocalAnswer answer;
+  answer.r.resize(problem.rows());
+  answer.u.resize(problem.rows());
+  LocalContactSolution solution{answer.r.data(), answer.u.data()};
+  ledas::solve_local_problem(solver, problem.view(tolerance), solution, answer.stats);
+  answer.converged = solution.converged;
+  return answer;
+}
+
 // The dropped sphere pyramid K = 20 at μ = 0.5 (bench_fclib's pyramid_drop_20_mu0.5, 590 contacts, 1,770
 // rows): every stage up to the sweeps leaves it near 1e-2 (the sweeps do not run above 1,000 rows, and
 // stalled at 0.06 when they did), and the projected fixed point from the relaxation's answer, with Newton
@@ -493,31 +510,11 @@ TEST(Fclib, ProjectionSolvesTheDroppedPyramidK20) {
   ledas::FrictionalSettings all_first;
   all_first.projection_stage_newton_steps = all_first.max_newton_steps;
   ledas::FrictionalSolver before(all_first);
-  std::vector<double> r_before(problem.rows()), u_before(problem.rows());
-  LocalContactSolution solution_before{r_before.data(), u_before.data()};
-  ledas::FrictionalStats stats_before;
-  ledas::solve_local_problem(before, problem.view(tolerance), solution_before, stats_before);
-  EXPECT_TRUE(solution_before.converged);
-  EXPECT_EQ(stats_before.projection_solved, 1u);
-  EXPECT_LE(stats.newton_steps + 200, stats_before.newton_steps);
-  for (std::size_t k = 0; k < u.size(); ++k) EXPECT_NEAR(u[k], u_before[k], 10 * tolerance) << "row " << k;
-}
-
-// A local problem solved by `solver` to `tolerance`: r, u = W r + q, and what the solve reports.
-struct LocalAnswer {
-  std::vector<double> r, u;
-  bool converged = false;
-  ledas::FrictionalStats stats;
-};
-
-LocalAnswer solve_local(ledas::FrictionalSolver& solver, const fclib::LocalProblem& problem, double tolerance) {
-  LocalAnswer answer;
-  answer.r.resize(problem.rows());
-  answer.u.resize(problem.rows());
-  LocalContactSolution solution{answer.r.data(), answer.u.data()};
-  ledas::solve_local_problem(solver, problem.view(tolerance), solution, answer.stats);
-  answer.converged = solution.converged;
-  return answer;
+  const LocalAnswer old_order = solve_local(before, problem, tolerance);
+  EXPECT_TRUE(old_order.converged);
+  EXPECT_EQ(old_order.stats.projection_solved, 1u);
+  EXPECT_LE(stats.newton_steps + 200, old_order.stats.newton_steps);
+  for (std::size_t k = 0; k < u.size(); ++k) EXPECT_NEAR(u[k], old_order.u[k], 10 * tolerance) << "row " << k;
 }
 
 // A standing stack of 40 boxes, each on four corners (160 contacts, μ = 0.5), given one step of gravity:
