@@ -4,11 +4,12 @@ namespace impetus::ledas {
 
 SparseLu::SparseLu() {
   klu_defaults(&common_);
-  // No row scaling, and no check of the matrix on each factorization: the Newton's Jacobian rows are
-  // already of unit scale (identity rows, and W's rows times ρ = 1/W_ii), and the matrix is assembled
-  // here on a pattern klu_analyze has checked. KLU's default (scale = 2: every row divided by its
-  // largest entry, on every refactorization) was 16% of the time of the frictional pile's large
-  // islands, whose factors have little fill (README, "Friction").
+  // No row scaling, and no check of the matrix on each factorization. The Jacobian's entries are of
+  // order one already: identity rows, and W's rows times ρ = 1/W_ii, whose diagonal is ~1 and whose
+  // entry ρ_i W_ij is at most √(W_jj / W_ii), in the rows KLU sees (Jᵀ's) as in J's. The matrix is
+  // assembled here on a pattern klu_analyze has checked. KLU's default (scale = 2: each row divided by
+  // its largest entry, and the matrix checked, at every refactorization) was 16% of the time of the
+  // frictional pile's large islands, whose factors have little fill (README, "Friction").
   common_.scale = -1;
 }
 
