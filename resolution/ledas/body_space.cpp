@@ -75,6 +75,8 @@ double excess(const Vector& p, const Vector& w, const Vector& c, double toleranc
   return worst;
 }
 
+}  // namespace
+
 // Products with G, Gᵀ and M from the blocks (BodySpace).
 void multiply_g(const BodySpace& body, const Vector& u, Vector& out) {
   out.resize(static_cast<Eigen::Index>(body.blocks.size()));
@@ -99,6 +101,8 @@ void multiply_g_transpose(const BodySpace& body, const Vector& p, Vector& out) {
   }
 }
 
+namespace {
+
 void multiply_m(const BodySpace& body, const Vector& u, Vector& out) {
   out.resize(u.size());
   for (std::size_t b = 0; b < body.mass.size(); ++b) {
@@ -108,10 +112,12 @@ void multiply_m(const BodySpace& body, const Vector& u, Vector& out) {
   }
 }
 
+}  // namespace
+
 // The block pattern of M + Gᵀ D G: block column t holds a block for every body s sharing a row with t
 // (and t itself), in increasing s. Records where each row's four blocks and each body's diagonal block
 // are, so that system_values() fills it in place.
-void build_pattern(const BodySpace& body, BodySpaceWorkspace& work) {
+void build_body_pattern(const BodySpace& body, BodySpaceWorkspace& work) {
   const auto blocks = static_cast<SparseIndex>(body.mass.size());
   std::vector<std::pair<SparseIndex, SparseIndex>>& pairs = work.pairs;  // (column block, row block)
   pairs.clear();
@@ -143,6 +149,8 @@ void build_pattern(const BodySpace& body, BodySpaceWorkspace& work) {
     work.offsets[r] = {place(a, a), b >= 0 ? place(a, b) : 0, b >= 0 ? place(b, a) : 0, b >= 0 ? place(b, b) : 0};
   }
 }
+
+namespace {
 
 // M + Gᵀ diag(d) G into `system`: per row, d_k g_s g_tᵀ added to its blocks (s, t).
 void system_values(const BodySpace& body, const Vector& d, BodySpaceWorkspace& work) {
@@ -207,7 +215,7 @@ bool solve_in_body_space(const ComplementarityProblem& problem, double stall_exc
   for (Eigen::Index k = 0; k < m; ++k) a_scale = std::max(a_scale, a.coeff(k, k));
   if (!(a_scale > 0.0)) return false;
 
-  build_pattern(body, work);
+  build_body_pattern(body, work);
   if (!work.analysed || !work.factor.same_pattern(work.neighbour_start, work.neighbours)) {
     work.factor.analyze(work.neighbour_start, work.neighbours);
     work.analysed = true;

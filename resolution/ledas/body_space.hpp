@@ -28,6 +28,14 @@ struct BodySpaceWorkspace {
   Vector best;  ///< the best iterate within reach of a stall's acceptance (body_space.cpp)
 };
 
+/// out = G u (one entry per row) and out = Gᵀ p (6 per block), from the rows' blocks.
+void multiply_g(const BodySpace& body, const Vector& u, Vector& out);
+void multiply_g_transpose(const BodySpace& body, const Vector& p, Vector& out);
+
+/// The block pattern of M + Gᵀ D G into `work` (neighbour_start, neighbours; `system` sized to it), and
+/// where each row's four blocks and each body's diagonal block lie in it (offsets, diagonal_offsets).
+void build_body_pattern(const BodySpace& body, BodySpaceWorkspace& work);
+
 /// Whether `problem` goes to the interior point first: it brings its body-space form, has no equality
 /// row, at least settings.interior_point_rows rows (0: never) and more rows than body coordinates (so A
 /// is singular: redundant contacts, where the active-set search releases a face's rows one by one).

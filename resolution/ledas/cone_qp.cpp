@@ -6,7 +6,11 @@
 // c = D⁻¹q, with the multiplier z = P x + c (= D⁻¹u) in the same cones and x ∘ z = 0 (Jordan product:
 // x ∘ z = (xᵀz, x₀ z₁ + z₀ x₁)). Each step scales both by Nesterov–Todd's T (T x = T⁻¹ z = λ) and solves
 // (P + T²) Δx = rhs, symmetric positive definite (T² is, on every row but the joint rows), by the sparse
-// LDLᵀ of the frictionless solver (MaskedLdlt: one analysis while W's pattern holds, parallel subtrees).
+// LDLᵀ of the frictionless solver (MaskedLdlt: one analysis while W's pattern holds, parallel subtrees);
+// or, where the problem brings W = G M⁻¹ Gᵀ's factors and has more rows than body coordinates, through
+// the bodies: P = B M⁻¹ Bᵀ with B = D⁻¹ G, and by Woodbury's identity (P + T²)⁻¹ b = H (b − B Δy) with
+// (M + Bᵀ H B) Δy = Bᵀ H b and H = T⁻² (regularized below), a system of 6 × 6 blocks per body
+// (BlockLdlt), smaller than the contacts' (README.md, "Friction": "The interior point in body space").
 #include "cone_qp.hpp"
 
 #include <algorithm>
@@ -32,6 +36,12 @@ constexpr int kCorrectors = 2;
 constexpr double kTrialStretch = 1.5, kTrialReach = 0.1;
 constexpr double kCentreLow = 0.1, kCentreHigh = 10.0;
 constexpr double kCorrectorGain = 1.01;
+// In body space: H = (T² + δ I)⁻¹ with δ = kBodyRegularization · max P_ii, a primal–dual regularization
+// as body_space.cpp's (without it H grows without bound on the cones that end pressed, and S = M + Bᵀ H B
+// with it); and the iteration ends when kBodyStall steps have not lowered the best residual (the
+// regularization's floor: the caller's Newton steps polish from there).
+constexpr double kBodyRegularization = 1e-10;
+constexpr std::uint64_t kBodyStall = 5;
 
 using Cone = ConeQpWorkspace::Cone;
 using Scaling = ConeQpWorkspace::Scaling;
@@ -185,6 +195,60 @@ void prepare_pattern(const SparseMatrix& w, ConeQpWorkspace& ws) {
   }
 }
 
+// The problem's body-space form if the interior point can use it: it matches the rows, has fewer
+// coordinates than rows, and every cone is a contact's (no joint row) whose rows share their bodies.
+const BodySpace* usable_body_space(const FrictionalProblem& problem, const std::vector<Cone>& cones) {
+  if (problem.body_space == nullptr) return nullptr;
+  const BodySpace* body = &problem.body_space->body_space();
+  const auto m = static_cast<std::size_t>(problem.q.size());
+  if (body->blocks.size() != m || body->jacobian.size() != m ||
+      body->inertia.size() != body->mass.size() || 6 * body->mass.size() >= m)
+    return nullptr;
+  const auto blocks = static_cast<std::int32_t>(body->mass.size());
+  for (const Cone& k : cones) {
+    if (k.free) return nullptr;
+    const auto [a, b] = body->blocks[static_cast<std::size_t>(k.first)];
+    if (a < 0 || a >= blocks || b < -1 || b >= blocks) return nullptr;
+    for (int j = 1; j < k.size; ++j)
+      if (body->blocks[static_cast<std::size_t>(k.first + j)] != body->blocks[static_cast<std::size_t>(k.first)])
+        return nullptr;
+  }
+  return body;
+}
+
+// S = M + Bᵀ H B into ws.body.system (B = D⁻¹ G): per cone, B_sᵀ H B_t added to its blocks (s, t).
+void body_system_values(const BodySpace& body, const std::vector<Cone>& cones, const Vector& d, ConeQpWorkspace& ws) {
+  using Block = BlockLdlt::Block;
+  using Rows = Eigen::Matrix<double, 3, 6>;
+  BodySpaceWorkspace& work = ws.body;
+  std::fill(work.system.begin(), work.system.end(), Block::Zero());
+  for (std::size_t b = 0; b < body.mass.size(); ++b) {
+    Block& diagonal = work.system[static_cast<std::size_t>(work.diagonal_offsets[b])];
+    diagonal.topLeftCorner<3, 3>().diagonal().setConstant(body.mass[b]);
+    diagonal.bottomRightCorner<3, 3>() = body.inertia[b];
+  }
+  const auto block = [&work](SparseIndex i) -> Block& { return work.system[static_cast<std::size_t>(i)]; };
+  for (std::size_t n = 0; n < cones.size(); ++n) {
+    const Cone& k = cones[n];
+    Rows ga = Rows::Zero(), gb = Rows::Zero();
+    for (int j = 0; j < k.size; ++j) {
+      const auto& g = body.jacobian[static_cast<std::size_t>(k.first + j)];
+      const double scale = 1.0 / d(k.first + j);
+      ga.row(j) = scale * Eigen::Map<const Eigen::Matrix<double, 1, 6>>(g.data());
+      gb.row(j) = scale * Eigen::Map<const Eigen::Matrix<double, 1, 6>>(g.data() + 6);
+    }
+    const Eigen::Matrix3d& h = ws.h_cone[n];
+    const Rows hga = h * ga;
+    const auto& at = work.offsets[static_cast<std::size_t>(k.first)];
+    block(at[0]).noalias() += ga.transpose() * hga;
+    if (body.blocks[static_cast<std::size_t>(k.first)][1] < 0) continue;
+    const Rows hgb = h * gb;
+    block(at[1]).noalias() += ga.transpose() * hgb;
+    block(at[2]).noalias() += gb.transpose() * hga;
+    block(at[3]).noalias() += gb.transpose() * hgb;
+  }
+}
+
 }  // namespace
 
 void solve_cone_qp(const FrictionalProblem& problem, double target, std::uint64_t max_iterations,
@@ -215,8 +279,24 @@ void solve_cone_qp(const FrictionalProblem& problem, double target, std::uint64_
     cones.push_back(k);
     i += k.size;
   }
-  prepare_pattern(w, ws);
-  if (!ldlt.same_pattern(ws.h)) ldlt.analyze(ws.h);
+  // In body space where the problem brings its factored form and has more rows than coordinates: the
+  // blocks' pattern (one analysis while it holds); else P + T² on W's pattern.
+  const BodySpace* body = usable_body_space(problem, cones);
+  const auto to_contact_space = [&] {
+    body = nullptr;
+    prepare_pattern(w, ws);
+    if (!ldlt.same_pattern(ws.h)) ldlt.analyze(ws.h);
+  };
+  if (body != nullptr) {
+    build_body_pattern(*body, ws.body);
+    if (!ws.body.analysed || !ws.body.factor.same_pattern(ws.body.neighbour_start, ws.body.neighbours)) {
+      ws.body.factor.analyze(ws.body.neighbour_start, ws.body.neighbours);
+      ws.body.analysed = true;
+    }
+    ws.h_cone.resize(cones.size());
+  } else {
+    to_contact_space();
+  }
   // P = D⁻¹ W D⁻¹ is not formed: its values go into h, and P x = D⁻¹ W (D⁻¹ x).
   double p_scale = std::numeric_limits<double>::min();
   for (Eigen::Index i = 0; i < m; ++i) p_scale = std::max(p_scale, w.coeff(i, i) / (d(i) * d(i)));
@@ -239,7 +319,7 @@ void solve_cone_qp(const FrictionalProblem& problem, double target, std::uint64_
   std::vector<Vec3d>& eta = ws.eta;
   best.setZero(m);
   double best_residual = std::numeric_limits<double>::infinity();
-  double* const h = ws.h.valuePtr();
+  std::uint64_t best_iteration = 0;
 
   for (; report.iterations < max_iterations; ++report.iterations) {
     r = x.cwiseQuotient(d);
@@ -248,41 +328,92 @@ void solve_cone_qp(const FrictionalProblem& problem, double target, std::uint64_
     const double residual = natural_map_residual(problem, r, u);
     if (residual < best_residual) {
       best_residual = residual;
+      best_iteration = report.iterations;
       best = r;
     }
     if (residual <= target) {
       report.converged = true;
       break;
     }
+    if (body != nullptr && report.iterations - best_iteration >= kBodyStall) break;
     rd = rd.cwiseQuotient(d) + c - z;  // the dual residual P x + c − z (z = 0 on joint rows)
     double gap = 0.0;
     for (const Cone& k : cones)
       if (!k.free) gap += block(x, k).dot(block(z, k));
     const double mu = degree > 0 ? gap / static_cast<double>(degree) : 0.0;
 
-    // h = P + T² (and the joint rows' shift) on its kept pattern.
-    std::fill(h, h + ws.h.nonZeros(), 0.0);
-    for (Eigen::Index col = 0, e = 0; col < m; ++col)
-      for (SparseMatrix::InnerIterator it(w, col); it; ++it, ++e)
-        h[ws.from_w[static_cast<std::size_t>(e)]] = it.value() / (d(it.row()) * d(col));
     bool numerical_end = false;
-    std::size_t entry = 0;
     for (std::size_t n = 0; n < cones.size(); ++n) {
       const Cone& k = cones[n];
-      if (k.free) {
-        h[ws.block[entry++]] += kFreeShift * p_scale;
-        continue;
-      }
+      if (k.free) continue;
       scaling[n] = nesterov_todd(block(x, k), block(z, k), k.size);
       if (!scaling[n].t2.allFinite()) {  // an iterate on a boundary to rounding: as far as it goes
         numerical_end = true;
         break;
       }
-      for (int a = 0; a < k.size; ++a)
-        for (int b = 0; b < k.size; ++b) h[ws.block[entry++]] += scaling[n].t2(a, b);
     }
     if (numerical_end) break;
-    ldlt.factorize(ws.h, ws.every_row, 0.0, 0.0);
+    if (body != nullptr) {
+      // S = M + Bᵀ H B, positive definite (M is); a pivot block that is not means rounding has won: the
+      // contact-space system from here on.
+      const double delta = kBodyRegularization * p_scale;
+      for (std::size_t n = 0; n < cones.size(); ++n) {
+        Eigen::Matrix3d& hn = ws.h_cone[n];
+        if (cones[n].size == 1) {
+          hn.setZero();
+          hn(0, 0) = 1.0 / (scaling[n].t2(0, 0) + delta);
+        } else {
+          hn = (scaling[n].t2 + delta * Eigen::Matrix3d::Identity()).inverse();
+        }
+      }
+      body_system_values(*body, cones, d, ws);
+      if (ws.body.factor.factorize(ws.body.system)) ++report.body_space_steps;
+      else to_contact_space();
+    }
+    if (body == nullptr) {
+      // h = P + T² (and the joint rows' shift) on its kept pattern.
+      double* const h = ws.h.valuePtr();
+      std::fill(h, h + ws.h.nonZeros(), 0.0);
+      for (Eigen::Index col = 0, e = 0; col < m; ++col)
+        for (SparseMatrix::InnerIterator it(w, col); it; ++it, ++e)
+          h[ws.from_w[static_cast<std::size_t>(e)]] = it.value() / (d(it.row()) * d(col));
+      std::size_t entry = 0;
+      for (std::size_t n = 0; n < cones.size(); ++n) {
+        const Cone& k = cones[n];
+        if (k.free) {
+          h[ws.block[entry++]] += kFreeShift * p_scale;
+          continue;
+        }
+        for (int a = 0; a < k.size; ++a)
+          for (int b = 0; b < k.size; ++b) h[ws.block[entry++]] += scaling[n].t2(a, b);
+      }
+      ldlt.factorize(ws.h, ws.every_row, 0.0, 0.0);
+    }
+    // (P + T²) Δx = b in place: by `ldlt`, or in body space by Woodbury's identity,
+    // Δx = H (b − B S⁻¹ Bᵀ H b).
+    const auto solve = [&](Vector& v) {
+      if (body == nullptr) {
+        ldlt.solve(v);
+        return;
+      }
+      ws.hb.resize(m);
+      for (std::size_t n = 0; n < cones.size(); ++n) {
+        const Cone& k = cones[n];
+        if (k.size == 1) ws.hb(k.first) = ws.h_cone[n](0, 0) * v(k.first);
+        else ws.hb.segment<3>(k.first).noalias() = ws.h_cone[n] * v.segment<3>(k.first);
+      }
+      ws.gy = ws.hb.cwiseQuotient(d);
+      multiply_g_transpose(*body, ws.gy, ws.y);
+      ws.body.factor.solve(ws.y);
+      multiply_g(*body, ws.y, ws.gy);
+      ws.gy.array() /= d.array();
+      v -= ws.gy;
+      for (std::size_t n = 0; n < cones.size(); ++n) {
+        const Cone& k = cones[n];
+        if (k.size == 1) v(k.first) *= ws.h_cone[n](0, 0);
+        else v.segment<3>(k.first) = ws.h_cone[n] * v.segment<3>(k.first).eval();
+      }
+    };
 
     // (P + T²) Δx = −r_d + T η,  Δz = T η − T² Δx,  with λ ∘ η = ξ per cone (without −r_d: a corrector).
     const auto direction = [&](Vector& dx, Vector& dz, bool residual = true) {
@@ -294,7 +425,7 @@ void solve_cone_qp(const FrictionalProblem& problem, double target, std::uint64_
         const Vec3d te = scaling[n].t * eta[n];
         for (int a = 0; a < k.size; ++a) dx(k.first + a) += te(a);
       }
-      ldlt.solve(dx);
+      solve(dx);
       dz.setZero(m);
       for (std::size_t n = 0; n < cones.size(); ++n) {
         const Cone& k = cones[n];

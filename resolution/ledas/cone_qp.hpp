@@ -12,6 +12,7 @@
 // symmetric problem gets a symmetric answer), where Newton on the natural map stalls.
 #include "impetus/resolution/ledas/frictional_solver.hpp"
 #include "impetus/resolution/ledas/masked_ldlt.hpp"
+#include "body_space.hpp"
 
 #include <Eigen/Core>
 
@@ -23,6 +24,7 @@ namespace impetus::ledas {
 struct ConeQpReport {
   std::uint64_t iterations = 0;  // interior-point steps (one factorization each)
   bool converged = false;        // the duality measure and the velocity residual fell below the tolerance
+  std::uint64_t body_space_steps = 0;  // of the steps, those whose system was solved in body space
 };
 
 /// The interior point's buffers, kept by the caller (FrictionalWorkspace): solving problems whose W has
@@ -48,11 +50,19 @@ struct ConeQpWorkspace {
   std::vector<SparseIndex> from_w, block, outer, inner;
   std::vector<char> every_row;
   Vector d, c, x, z, r, best, rd, u, dx_aff, dz_aff, dx, dz;  // u = W r + q of the iterate r
+  // In body space (FrictionalProblem::body_space, more rows than body coordinates): (P + T²) Δx = b
+  // through M + Bᵀ H B by 6 × 6 blocks (B = D⁻¹ G, H = (T² + δ I)⁻¹ per cone), its pattern and factor
+  // in `body`; H per cone, and the solve's vectors.
+  BodySpaceWorkspace body;
+  std::vector<Eigen::Matrix3d> h_cone;
+  Vector hb, y, gy;
 };
 
 /// Into r (size m): the relaxation's impulses, the iterate with the smallest natural-map residual of the
 /// relaxation (`problem` is the relaxation: `convex`), stopping when it is ≤ `target` or after
-/// `max_iterations` steps (the caller then polishes it with Newton on the natural map). `ldlt` factorizes
+/// `max_iterations` steps (the caller then polishes it with Newton on the natural map). With
+/// `problem.body_space` and more rows than body coordinates, each step's system is solved in body space
+/// (cone_qp.cpp) and `ldlt` is left as it was; else `ldlt` factorizes
 /// P + T², analysed afresh only when its pattern changed: when every cone's block lies in W's pattern
 /// (a contact's rows share W's pattern), that is W's pattern, so the caller's Newton steps on W
 /// (frictional_solver.cpp, `symmetric_direction`) share its analysis.

@@ -90,6 +90,28 @@ void LedasResolver::apply_island_impulse(ledas::Island& island, const Vector& p,
 // value (ΔE is quadratic in α), so no impact creates energy for any e ≤ 1.
 void LedasResolver::velocity_frictional(ledas::Island& island, std::span<RigidBody> bodies, Lane& lane) {
   const std::size_t m = island.rows.size();
+  // W's factored form, for the interior point of an island with more rows than body coordinates (a
+  // pyramid, a stack: cone_qp.hpp), assembled when that first asks. Positions do not change within the
+  // step, so it holds for every round and both phases; the problem forgets it on return.
+  struct Source final : ledas::BodySpaceSource {
+    std::span<const resolution::ImpulseRow> rows;
+    ledas::Island* island = nullptr;
+    std::span<const RigidBody> bodies;
+    bool assembled = false;
+    const ledas::BodySpace& body_space() override {
+      if (!assembled) ledas::assemble_body_space(rows, *island, {}, bodies, island->body_space);
+      assembled = true;
+      return island->body_space;
+    }
+  } source;
+  source.rows = rows_;
+  source.island = &island;
+  source.bodies = bodies;
+  struct Forget {
+    ledas::FrictionalProblem& problem;
+    ~Forget() { problem.body_space = nullptr; }
+  } forget{island.friction};
+  island.friction.body_space = ledas::wants_body_space(island, m, solver_settings_) ? &source : nullptr;
   const Vector& v0 = island.velocity_start = current_velocities(island, bodies);
   const double energy0 = ledas::kinetic_energy(bodies, island.bodies);
   bool needed = false;

@@ -664,6 +664,7 @@ void add(FrictionalStats& into, const FrictionalStats& part) {
   into.newton_steps += part.newton_steps;
   into.newton_reused += part.newton_reused;
   into.interior_point_steps += part.interior_point_steps;
+  into.interior_point_body_steps += part.interior_point_body_steps;
   into.proximal += part.proximal;
   into.proximal_steps += part.proximal_steps;
   into.nonsmooth_sweeps += part.nonsmooth_sweeps;
@@ -950,6 +951,7 @@ void FrictionalSolver::solve(const FrictionalProblem& problem, FrictionalStats& 
       const double loose = kSlipCheckTarget * relaxed.tolerance;
       solve_cone_qp(relaxed, loose, settings_.interior_point_iterations, buffers.cone_qp, buffers.ldlt, r, report);
       stats.interior_point_steps += report.iterations;
+      stats.interior_point_body_steps += report.body_space_steps;
       slip_taken = report.converged && natural_map_residual(problem, r) > kSlipCheckMargin * loose;
     }
     bool warm_answer_taken = slip_taken;
@@ -1411,6 +1413,7 @@ double FrictionalSolver::solve_stages(const FrictionalProblem& problem, Vector& 
     solve_cone_qp(problem, problem.tolerance, settings_.interior_point_iterations, buffers.cone_qp, buffers.ldlt, r,
                   report);
     stats.interior_point_steps += report.iterations;
+    stats.interior_point_body_steps += report.body_space_steps;
     residual = natural_map_residual(problem, r);
     warm = polish = true;
   }

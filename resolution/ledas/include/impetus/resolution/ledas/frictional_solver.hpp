@@ -57,6 +57,18 @@
 
 namespace impetus::ledas {
 
+struct BodySpace;  // island_solver.hpp
+
+/// W's factored form G M⁻¹ Gᵀ over a problem's rows (BodySpace), handed out on first use: only the
+/// interior point reads it, and most problems (a warm start that solves) never get there.
+class BodySpaceSource {
+ public:
+  virtual const BodySpace& body_space() = 0;
+
+ protected:
+  ~BodySpaceSource() = default;
+};
+
 /// What a row of a frictional problem is.
 enum class RowRole : std::uint8_t {
   equality,  ///< a joint row: u = 0, r free
@@ -100,6 +112,9 @@ struct FrictionalProblem {
   /// static equilibrium (u = 0 with r in the cones), when one exists, is its answer.
   bool convex = false;
   FrictionalWorkspace* workspace = nullptr;  ///< buffers to solve in (null: the solve's own)
+  /// W's factored form G M⁻¹ Gᵀ over the same rows, optional: with it the interior point of a problem
+  /// with more rows than body coordinates solves its Newton systems in body space (cone_qp.hpp).
+  BodySpaceSource* body_space = nullptr;
 };
 
 /// How frictional problems are solved (configuration).
@@ -195,6 +210,8 @@ struct FrictionalStats {
   std::uint64_t newton_steps = 0;      ///< Newton steps (one factorization each, but newton_reused)
   std::uint64_t newton_reused = 0;     ///< Newton steps that reused the step before's factorization (same matrix)
   std::uint64_t interior_point_steps = 0;  ///< interior-point steps on relaxations (one factorization each)
+  /// of those, steps whose Newton system was solved in body space (FrictionalProblem::body_space)
+  std::uint64_t interior_point_body_steps = 0;
   std::uint64_t proximal = 0;          ///< problems that needed the proximal stage (redundant contacts)
   std::uint64_t proximal_steps = 0;    ///< its proximal points (a Newton solve each)
   std::uint64_t nonsmooth_sweeps = 0;  ///< nonsmooth Gauss–Seidel sweeps (FrictionalSettings::nonsmooth_sweeps)
