@@ -321,38 +321,33 @@ void solve_cone_qp(const FrictionalProblem& problem, double target, std::uint64_
   double best_residual = std::numeric_limits<double>::infinity();
   std::uint64_t best_iteration = 0;
 
-  for (; report.iterations < max_iterations; ++report.iterations) {
-    r = x.cwiseQuotient(d);
-    rd.noalias() = w.transpose() * r;  // = W r (symmetric), as a gather
-    u = rd + problem.q;
-    const double residual = natural_map_residual(problem, r, u);
-    if (residual < best_residual) {
-      best_residual = residual;
-      best_iteration = report.iterations;
-      best = r;
+  // (P + T²) Δx = b in place: by `ldlt`, or in body space by Woodbury's identity,
+  // Δx = H (b − B S⁻¹ Bᵀ H b).
+  const auto solve = [&](Vector& v) {
+    if (body == nullptr) {
+      ldlt.solve(v);
+      return;
     }
-    if (residual <= target) {
-      report.converged = true;
-      break;
-    }
-    if (body != nullptr && report.iterations - best_iteration >= kBodyStall) break;
-    rd = rd.cwiseQuotient(d) + c - z;  // the dual residual P x + c − z (z = 0 on joint rows)
-    double gap = 0.0;
-    for (const Cone& k : cones)
-      if (!k.free) gap += block(x, k).dot(block(z, k));
-    const double mu = degree > 0 ? gap / static_cast<double>(degree) : 0.0;
-
-    bool numerical_end = false;
+    ws.hb.resize(m);
     for (std::size_t n = 0; n < cones.size(); ++n) {
       const Cone& k = cones[n];
-      if (k.free) continue;
-      scaling[n] = nesterov_todd(block(x, k), block(z, k), k.size);
-      if (!scaling[n].t2.allFinite()) {  // an iterate on a boundary to rounding: as far as it goes
-        numerical_end = true;
-        break;
-      }
+      if (k.size == 1) ws.hb(k.first) = ws.h_cone[n](0, 0) * v(k.first);
+      else ws.hb.segment<3>(k.first).noalias() = ws.h_cone[n] * v.segment<3>(k.first);
     }
-    if (numerical_end) break;
+    ws.gy = ws.hb.cwiseQuotient(d);
+    multiply_g_transpose(*body, ws.gy, ws.y);
+    ws.body.factor.solve(ws.y);
+    multiply_g(*body, ws.y, ws.gy);
+    ws.gy.array() /= d.array();
+    v -= ws.gy;
+    for (std::size_t n = 0; n < cones.size(); ++n) {
+      const Cone& k = cones[n];
+      if (k.size == 1) v(k.first) *= ws.h_cone[n](0, 0);
+      else v.segment<3>(k.first) = ws.h_cone[n] * v.segment<3>(k.first).eval();
+    }
+  };
+  // P + T² for the current scaling, factorized: in body space (S = M + Bᵀ H B) or by `ldlt`.
+  const auto factorize = [&] {
     if (body != nullptr) {
       // S = M + Bᵀ H B, positive definite (M is); a pivot block that is not means rounding has won: the
       // contact-space system from here on.
@@ -389,31 +384,41 @@ void solve_cone_qp(const FrictionalProblem& problem, double target, std::uint64_
       }
       ldlt.factorize(ws.h, ws.every_row, 0.0, 0.0);
     }
-    // (P + T²) Δx = b in place: by `ldlt`, or in body space by Woodbury's identity,
-    // Δx = H (b − B S⁻¹ Bᵀ H b).
-    const auto solve = [&](Vector& v) {
-      if (body == nullptr) {
-        ldlt.solve(v);
-        return;
+  };
+
+  for (; report.iterations < max_iterations; ++report.iterations) {
+    r = x.cwiseQuotient(d);
+    rd.noalias() = w.transpose() * r;  // = W r (symmetric), as a gather
+    u = rd + problem.q;
+    const double residual = natural_map_residual(problem, r, u);
+    if (residual < best_residual) {
+      best_residual = residual;
+      best_iteration = report.iterations;
+      best = r;
+    }
+    if (residual <= target) {
+      report.converged = true;
+      break;
+    }
+    if (body != nullptr && report.iterations - best_iteration >= kBodyStall) break;
+    rd = rd.cwiseQuotient(d) + c - z;  // the dual residual P x + c − z (z = 0 on joint rows)
+    double gap = 0.0;
+    for (const Cone& k : cones)
+      if (!k.free) gap += block(x, k).dot(block(z, k));
+    const double mu = degree > 0 ? gap / static_cast<double>(degree) : 0.0;
+
+    bool numerical_end = false;
+    for (std::size_t n = 0; n < cones.size(); ++n) {
+      const Cone& k = cones[n];
+      if (k.free) continue;
+      scaling[n] = nesterov_todd(block(x, k), block(z, k), k.size);
+      if (!scaling[n].t2.allFinite()) {  // an iterate on a boundary to rounding: as far as it goes
+        numerical_end = true;
+        break;
       }
-      ws.hb.resize(m);
-      for (std::size_t n = 0; n < cones.size(); ++n) {
-        const Cone& k = cones[n];
-        if (k.size == 1) ws.hb(k.first) = ws.h_cone[n](0, 0) * v(k.first);
-        else ws.hb.segment<3>(k.first).noalias() = ws.h_cone[n] * v.segment<3>(k.first);
-      }
-      ws.gy = ws.hb.cwiseQuotient(d);
-      multiply_g_transpose(*body, ws.gy, ws.y);
-      ws.body.factor.solve(ws.y);
-      multiply_g(*body, ws.y, ws.gy);
-      ws.gy.array() /= d.array();
-      v -= ws.gy;
-      for (std::size_t n = 0; n < cones.size(); ++n) {
-        const Cone& k = cones[n];
-        if (k.size == 1) v(k.first) *= ws.h_cone[n](0, 0);
-        else v.segment<3>(k.first) = ws.h_cone[n] * v.segment<3>(k.first).eval();
-      }
-    };
+    }
+    if (numerical_end) break;
+    factorize();
 
     // (P + T²) Δx = −r_d + T η,  Δz = T η − T² Δx,  with λ ∘ η = ξ per cone (without −r_d: a corrector).
     const auto direction = [&](Vector& dx, Vector& dz, bool residual = true) {
