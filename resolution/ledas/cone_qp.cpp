@@ -37,9 +37,9 @@ constexpr double kTrialStretch = 1.5, kTrialReach = 0.1;
 constexpr double kCentreLow = 0.1, kCentreHigh = 10.0;
 constexpr double kCorrectorGain = 1.01;
 // In body space: H = (T² + δ I)⁻¹ with δ = kBodyRegularization · max P_ii, a primal–dual regularization
-// as body_space.cpp's (without it H grows without bound on the cones that end pressed, and S = M + Bᵀ H B
-// with it); and the iteration ends when kBodyStall steps have not lowered the best residual (the
-// regularization's floor: the caller's Newton steps polish from there).
+// as body_space.cpp's (without it H, and S = M + Bᵀ H B with it, grow without bound on the cones that
+// end pressed, where T² goes to 0); and the iteration ends when kBodyStall steps have not lowered the
+// best residual (the regularization's floor: the caller's Newton steps polish from there).
 constexpr double kBodyRegularization = 1e-10;
 constexpr std::uint64_t kBodyStall = 5;
 
