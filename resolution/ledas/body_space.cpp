@@ -116,7 +116,7 @@ void multiply_m(const BodySpace& body, const Vector& u, Vector& out) {
 
 // The block pattern of M + Gᵀ D G: block column t holds a block for every body s sharing a row with t
 // (and t itself), in increasing s. Records where each row's four blocks and each body's diagonal block
-// are, so that system_values() fills it in place.
+// are, so that system_values() (and cone_qp.cpp's body-space system) fill it in place.
 void build_body_pattern(const BodySpace& body, BodySpaceWorkspace& work) {
   const auto blocks = static_cast<SparseIndex>(body.mass.size());
   std::vector<std::pair<SparseIndex, SparseIndex>>& pairs = work.pairs;  // (column block, row block)
@@ -150,18 +150,23 @@ void build_body_pattern(const BodySpace& body, BodySpaceWorkspace& work) {
   }
 }
 
-namespace {
-
-// M + Gᵀ diag(d) G into `system`: per row, d_k g_s g_tᵀ added to its blocks (s, t).
-void system_values(const BodySpace& body, const Vector& d, BodySpaceWorkspace& work) {
+void mass_blocks(const BodySpace& body, BodySpaceWorkspace& work) {
   using Block = BlockLdlt::Block;
-  using Row = Eigen::Map<const Eigen::Matrix<double, 6, 1>>;
   std::fill(work.system.begin(), work.system.end(), Block::Zero());
   for (std::size_t b = 0; b < body.mass.size(); ++b) {
     Block& diagonal = work.system[static_cast<std::size_t>(work.diagonal_offsets[b])];
     diagonal.topLeftCorner<3, 3>().diagonal().setConstant(body.mass[b]);
     diagonal.bottomRightCorner<3, 3>() = body.inertia[b];
   }
+}
+
+namespace {
+
+// M + Gᵀ diag(d) G into `system`: per row, d_k g_s g_tᵀ added to its blocks (s, t).
+void system_values(const BodySpace& body, const Vector& d, BodySpaceWorkspace& work) {
+  using Block = BlockLdlt::Block;
+  using Row = Eigen::Map<const Eigen::Matrix<double, 6, 1>>;
+  mass_blocks(body, work);
   for (std::size_t k = 0; k < body.blocks.size(); ++k) {
     const std::int32_t b = body.blocks[k][1];
     const Row ga(body.jacobian[k].data()), gb(body.jacobian[k].data() + 6);

@@ -36,6 +36,9 @@ void multiply_g_transpose(const BodySpace& body, const Vector& p, Vector& out);
 /// where each row's four blocks and each body's diagonal block lie in it (offsets, diagonal_offsets).
 void build_body_pattern(const BodySpace& body, BodySpaceWorkspace& work);
 
+/// `work.system` (on build_body_pattern's pattern) set to M: each body's diag(m I₃, J), zero elsewhere.
+void mass_blocks(const BodySpace& body, BodySpaceWorkspace& work);
+
 /// Whether `problem` goes to the interior point first: it brings its body-space form, has no equality
 /// row, at least settings.interior_point_rows rows (0: never) and more rows than body coordinates (so A
 /// is singular: redundant contacts, where the active-set search releases a face's rows one by one).

@@ -221,12 +221,7 @@ void body_system_values(const BodySpace& body, const std::vector<Cone>& cones, c
   using Block = BlockLdlt::Block;
   using Rows = Eigen::Matrix<double, 3, 6>;
   BodySpaceWorkspace& work = ws.body;
-  std::fill(work.system.begin(), work.system.end(), Block::Zero());
-  for (std::size_t b = 0; b < body.mass.size(); ++b) {
-    Block& diagonal = work.system[static_cast<std::size_t>(work.diagonal_offsets[b])];
-    diagonal.topLeftCorner<3, 3>().diagonal().setConstant(body.mass[b]);
-    diagonal.bottomRightCorner<3, 3>() = body.inertia[b];
-  }
+  mass_blocks(body, work);
   const auto block = [&work](SparseIndex i) -> Block& { return work.system[static_cast<std::size_t>(i)]; };
   for (std::size_t n = 0; n < cones.size(); ++n) {
     const Cone& k = cones[n];
