@@ -1029,9 +1029,10 @@ void FrictionalSolver::solve(const FrictionalProblem& problem, FrictionalStats& 
     //    On a problem that had a warm start (an island of a running scene), at most
     //    `warm_stage_newton_steps` there: the stages after this one, or the next step, go on. On a cold
     //    one that the projection stage (5b) would take next, at most `projection_stage_newton_steps`
-    //    (50) first, the rest of `max_newton_steps` after the projection if it fails too: on the dropped
-    //    sphere pyramids K = 20 (1,770 rows) these stages spent their 300 steps, 1.3–1.5 s, for nothing
-    //    before the projection solved them (at μ = 0.5 1.8 → 0.83 s for the whole solve, the same answer).
+    //    (none by default) first, the rest of `max_newton_steps` after the projection if it fails too: on
+    //    the dropped sphere pyramids K = 20 (1,770 rows) these stages spent their 300 steps, 1.3–1.5 s,
+    //    and then 50, for nothing before the projection solved them (at μ = 0.5 1.8 → 0.83 s for the
+    //    whole solve, then 0.63 → 0.43 s, the same answer).
     const auto rows = static_cast<std::size_t>(problem.q.size());
     const bool projection_follows = settings_.projection_iterations > 0 && !warm &&
                                     (rows > settings_.nonsmooth_rows || settings_.nonsmooth_sweeps == 0) &&

@@ -504,9 +504,10 @@ TEST(Fclib, ProjectionSolvesTheDroppedPyramidK20) {
   EXPECT_EQ(stats.nonsmooth_sweeps, 0u);
   expect_coulomb_with_slip(problem, r, u, tolerance);
 
-  // The Newton stages before the projection get projection_stage_newton_steps (50) of their 300 steps:
-  // with all 300 (the order until 2026-12-06, night) they fail as well, and the projection, started from the
-  // relaxation's answer either way, reaches the same answer. At least 200 Newton steps fewer.
+  // The Newton stages before the projection get projection_stage_newton_steps (none since 2026-12-07, 50
+  // before) of their 300 steps: with all 300 (the order until 2026-12-06, night) they fail as well, and the
+  // projection, started from the relaxation's answer either way, reaches the same answer. At least 200
+  // Newton steps fewer.
   ledas::FrictionalSettings all_first;
   all_first.projection_stage_newton_steps = all_first.max_newton_steps;
   ledas::FrictionalSolver before(all_first);

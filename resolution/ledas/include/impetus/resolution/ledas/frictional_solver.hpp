@@ -25,7 +25,8 @@
 ///     answer has no pressed contact slipping it is Coulomb's answer;
 ///  2. else Newton on Coulomb's problem from it, one step of Cadoux's fixed point (the relaxation with q_n
 ///     raised by μ‖u_t‖), and the Newton stages below (on a cold problem the projection below would take
-///     next, only `projection_stage_newton_steps` of them before it, the rest after it if it fails);
+///     next, only `projection_stage_newton_steps` of them (none by default) before it, the rest after it
+///     if it fails);
 ///  3. still unsolved: more of Cadoux's steps (`fixed_point_iterations`, on problems of at most
 ///     `fixed_point_rows`), then nonsmooth Gauss–Seidel sweeps from r = 0 (each contact's own problem
 ///     solved exactly in turn; at most `nonsmooth_rows`) and Newton from their iterate, or on larger
@@ -134,7 +135,9 @@ struct FrictionalSettings {
   /// the rest of `max_newton_steps` runs after that stage if it fails too. On the dropped sphere
   /// pyramids K = 20 at μ = 0.5 and 0.2, the stages spent their 300 steps (1.3–1.5 s) and failed, and
   /// the projection solved them from the relaxation's answer as before: 1.8 → 0.83 s and 2.6 → 1.3 s.
-  std::uint64_t projection_stage_newton_steps = 50;
+  /// 50 steps failed there too; no problem of the benchmarks or of the frictional pile's first 500 steps
+  /// that reaches this point is solved by them, so none (resolution/ledas/README.md, "Friction").
+  std::uint64_t projection_stage_newton_steps = 0;
   std::uint64_t interior_point_iterations = 60;  ///< interior-point steps on the convex relaxation at most
   /// Cadoux's fixed-point steps (relaxations) at most: the first before the Newton stages, the others
   /// after them if they fail (up to `fixed_point_rows`), ended when 3 steps do not halve their residual.
