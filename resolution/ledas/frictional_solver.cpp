@@ -105,6 +105,112 @@ struct Linearization {
   double ratio = 0.0;             // slide: c = μ z_n / ‖z_t‖ (< 1); surface: μ s / ‖z_t‖
 };
 
+// W by its blocks of a contact's rows (1 or 3 rows each), block row after block row, for the projection
+// stage's product with W at every iteration: a contact's rows share their columns, so one index is read
+// per block instead of one per entry, and a 3 × 3 block's nine products run on three rows at once. Each
+// row's sum runs over the same entries in the same order as W's own product (W symmetric, a row read as
+// its column, entries by increasing row): the same bits as `w.transpose() * x`, with +0 for an entry
+// one row of a block lacks and another has. On the dropped pyramid K = 20 (1,770 rows, 53,874 entries),
+// a product took 12.7 µs against 22.5 µs (a scratch loop of 5,000).
+class BlockedW {
+ public:
+  void assign(const SparseMatrix& w, const std::vector<Block>& blocks);
+  void multiply(const Vector& x, Vector& y) const;  ///< y = W x
+
+ private:
+  std::vector<Eigen::Index> first_;    // per block: its first row
+  std::vector<int> size_;              // its rows, 1 or 3
+  std::vector<std::size_t> start_;     // per block row: its first entry in column_ and value_at_
+  std::vector<int> column_;            // per stored block: its block column
+  std::vector<std::size_t> value_at_;  // its first value in value_ (rows × columns, by rows)
+  std::vector<double> value_;
+  std::vector<int> block_of_row_;            // assign's scratch: each row's block
+  std::vector<std::size_t> slot_, seen_;     // a block column's place in the current block row, and
+                                             // the block row that last saw it (+1; 0: none)
+};
+
+void BlockedW::assign(const SparseMatrix& w, const std::vector<Block>& blocks) {
+  const std::size_t n = blocks.size();
+  block_of_row_.resize(static_cast<std::size_t>(w.rows()));
+  first_.resize(n);
+  size_.resize(n);
+  for (std::size_t k = 0; k < n; ++k) {
+    first_[k] = blocks[k].first;
+    size_[k] = blocks[k].size;
+    for (int i = 0; i < blocks[k].size; ++i) block_of_row_[static_cast<std::size_t>(blocks[k].first + i)] = static_cast<int>(k);
+  }
+  slot_.resize(n);
+  seen_.assign(n, 0);
+  start_.assign(1, 0);
+  column_.clear();
+  value_at_.clear();
+  value_.clear();
+  for (std::size_t b = 0; b < n; ++b) {
+    const std::size_t begin = column_.size();
+    for (int i = 0; i < size_[b]; ++i)
+      for (SparseMatrix::InnerIterator it(w, first_[b] + i); it; ++it)
+        if (const int c = block_of_row_[static_cast<std::size_t>(it.row())]; seen_[static_cast<std::size_t>(c)] != b + 1) {
+          seen_[static_cast<std::size_t>(c)] = b + 1;
+          column_.push_back(c);
+        }
+    std::sort(column_.begin() + static_cast<std::ptrdiff_t>(begin), column_.end());
+    for (std::size_t p = begin; p < column_.size(); ++p) {
+      const auto c = static_cast<std::size_t>(column_[p]);
+      slot_[c] = p;
+      value_at_.push_back(value_.size());
+      value_.resize(value_.size() + static_cast<std::size_t>(size_[b] * size_[c]), 0.0);
+    }
+    for (int i = 0; i < size_[b]; ++i)  // W(first_b + i, first_c + j) = column first_b + i at row first_c + j
+      for (SparseMatrix::InnerIterator it(w, first_[b] + i); it; ++it) {
+        const auto c = static_cast<std::size_t>(block_of_row_[static_cast<std::size_t>(it.row())]);
+        value_[value_at_[slot_[c]] + static_cast<std::size_t>(i * size_[c]) + static_cast<std::size_t>(it.row() - first_[c])] = it.value();
+      }
+    start_.push_back(column_.size());
+  }
+}
+
+void BlockedW::multiply(const Vector& x, Vector& y) const {
+  y.resize(x.size());
+  for (std::size_t b = 0; b + 1 < start_.size(); ++b) {
+    const Eigen::Index row = first_[b];
+    if (size_[b] == 3) {
+      double s0 = 0.0, s1 = 0.0, s2 = 0.0;
+      for (std::size_t p = start_[b]; p < start_[b + 1]; ++p) {
+        const auto c = static_cast<std::size_t>(column_[p]);
+        const double* v = value_.data() + value_at_[p];
+        const double* xc = x.data() + first_[c];
+        if (size_[c] == 3) {
+          s0 += v[0] * xc[0];
+          s0 += v[1] * xc[1];
+          s0 += v[2] * xc[2];
+          s1 += v[3] * xc[0];
+          s1 += v[4] * xc[1];
+          s1 += v[5] * xc[2];
+          s2 += v[6] * xc[0];
+          s2 += v[7] * xc[1];
+          s2 += v[8] * xc[2];
+        } else {
+          s0 += v[0] * xc[0];
+          s1 += v[1] * xc[0];
+          s2 += v[2] * xc[0];
+        }
+      }
+      y(row) = s0;
+      y(row + 1) = s1;
+      y(row + 2) = s2;
+    } else {
+      double sum = 0.0;
+      for (std::size_t p = start_[b]; p < start_[b + 1]; ++p) {
+        const auto c = static_cast<std::size_t>(column_[p]);
+        const double* v = value_.data() + value_at_[p];
+        const double* xc = x.data() + first_[c];
+        for (int j = 0; j < size_[c]; ++j) sum += v[j] * xc[j];
+      }
+      y(row) = sum;
+    }
+  }
+}
+
 }  // namespace
 
 // Newton's buffers (sized on first use, reused while the problem's size does not change).
@@ -154,6 +260,7 @@ struct FrictionalWorkspace::Newton {
   // power method's vectors and the stage's answer.
   Vector projection_r, projection_u, projection_f, projection_weight, projection_power, projection_image,
       projection_best;
+  BlockedW projection_w;  // W by blocks, for its products
   Vector relaxation_answer;  // Cadoux's fixed point: the last relaxation's answer
   Vector relaxation_first;   // the first relaxation's answer (the projection stage starts from it)
 };
@@ -1174,9 +1281,9 @@ namespace {
 
 // F(r) = u + μ‖u_t‖ e_n (De Saxcé's modified velocity at each frictional contact; u itself at the other
 // rows) with u = W r + q, into u and f.
-void modified_velocity(const FrictionalProblem& problem, const std::vector<Block>& blocks, const Vector& r,
-                       Vector& u, Vector& f) {
-  u.noalias() = problem.w->transpose() * r;  // = W r (symmetric), as a gather
+void modified_velocity(const FrictionalProblem& problem, const std::vector<Block>& blocks, const BlockedW& w,
+                       const Vector& r, Vector& u, Vector& f) {
+  w.multiply(r, u);
   u += problem.q;
   f = u;
   for (const Block& b : blocks)
@@ -1212,7 +1319,8 @@ double FrictionalSolver::projection(const FrictionalProblem& problem, const std:
   Vector &x = buffers.projection_r, &u = buffers.projection_u, &f = buffers.projection_f;
   Vector &weight = buffers.projection_weight, &power = buffers.projection_power, &image = buffers.projection_image;
   Vector& polished = buffers.polished;
-  const SparseMatrix& w = *problem.w;
+  BlockedW& blocked = buffers.projection_w;
+  blocked.assign(*problem.w, blocks);
   const Eigen::Index m = problem.q.size();
   weight.resize(m);
   for (const Block& b : blocks) weight.segment(b.first, b.size).setConstant(b.rho_n);
@@ -1221,7 +1329,8 @@ double FrictionalSolver::projection(const FrictionalProblem& problem, const std:
   power.setOnes(m);
   power /= power.norm();
   for (int k = 0; k < kPowerIterations; ++k) {
-    image.noalias() = w.transpose() * power.cwiseProduct(weight.cwiseSqrt());
+    polished = power.cwiseProduct(weight.cwiseSqrt());
+    blocked.multiply(polished, image);
     image.array() *= weight.array().sqrt();
     lambda = image.norm();
     if (!(lambda > 0.0) || !std::isfinite(lambda)) return natural_map_residual(problem, r);
@@ -1230,7 +1339,7 @@ double FrictionalSolver::projection(const FrictionalProblem& problem, const std:
   double rho = kProjectionStep / lambda;
   x = r;
   project_on_blocks(blocks, x);
-  modified_velocity(problem, blocks, x, u, f);
+  modified_velocity(problem, blocks, blocked, x, u, f);
   double best_residual = natural_map_residual(problem, x, u);
   r = x;
   double mark = best_residual;  // the best residual kProjectionStall iterations ago
@@ -1239,13 +1348,13 @@ double FrictionalSolver::projection(const FrictionalProblem& problem, const std:
     ++stats.projection_iterations;
     x -= rho * weight.cwiseProduct(f);
     project_on_blocks(blocks, x);
-    modified_velocity(problem, blocks, x, u, f);
+    modified_velocity(problem, blocks, blocked, x, u, f);
     if (k % kProjectionCheck != 0) continue;
     const double now = natural_map_residual(problem, x, u);
     if (!(now <= kProjectionDiverged * best_residual)) {  // diverging (or not finite): a shorter step
       rho *= 0.5;
       x = r;
-      modified_velocity(problem, blocks, x, u, f);
+      modified_velocity(problem, blocks, blocked, x, u, f);
       continue;
     }
     if (now < best_residual) {

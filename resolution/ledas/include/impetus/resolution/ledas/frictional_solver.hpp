@@ -178,7 +178,7 @@ struct FrictionalSettings {
   /// is tried from their iterate as it nears a solution. 0: none.
   std::uint64_t projection_iterations = 131072;
   /// The projection stage runs on problems of at most this many rows (an iteration of 1,770 rows, the
-  /// sphere pyramid K = 20, costs ~25 µs).
+  /// sphere pyramid K = 20, costs ~15 µs).
   std::size_t projection_rows = 4000;
   /// A problem of at most this many contacts that the stages leave unsolved is tried with one contact
   /// released: a pressed contact that separates at the best iterate (r_n > 0, u_n > 0) may belong open,
