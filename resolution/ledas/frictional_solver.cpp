@@ -1329,8 +1329,8 @@ double FrictionalSolver::projection(const FrictionalProblem& problem, const std:
   power.setOnes(m);
   power /= power.norm();
   for (int k = 0; k < kPowerIterations; ++k) {
-    polished = power.cwiseProduct(weight.cwiseSqrt());
-    blocked.multiply(polished, image);
+    f = power.cwiseProduct(weight.cwiseSqrt());  // f: scratch until the iteration sets it
+    blocked.multiply(f, image);
     image.array() *= weight.array().sqrt();
     lambda = image.norm();
     if (!(lambda > 0.0) || !std::isfinite(lambda)) return natural_map_residual(problem, r);
