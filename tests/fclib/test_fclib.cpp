@@ -518,6 +518,36 @@ TEST(Fclib, ProjectionSolvesTheDroppedPyramidK20) {
   for (std::size_t k = 0; k < u.size(); ++k) EXPECT_NEAR(u[k], old_order.u[k], 10 * tolerance) << "row " << k;
 }
 
+// The dropped sphere pyramid K = 10 at μ = 0.5 (bench_fclib's pyramid_drop_10_mu0.5, 435 rows): Newton
+// from the relaxation's answer and one step of Cadoux's fixed point leave it unsolved, and the proximal
+// rounds took some 300 Newton steps to solve it. The interior point on Coulomb's problem itself
+// (cone_qp.hpp, since 2026-12-07) solves it after Newton's first attempt, in about 12 steps: checked
+// against Coulomb's law contact by contact, and at least 200 Newton steps fewer than without it.
+TEST(Fclib, CoulombInteriorPointSolvesTheDroppedPyramidK10) {
+  PluginHost host;
+  const Case c{"pyramid_drop_10.yaml", {"generators.0.pyramid.friction=0.5"}, nullptr};
+  std::unique_ptr<World> world = make_world(c, host);
+  world->detect_contacts();
+  ASSERT_EQ(world->contacts().size(), 145u);
+  const fclib::LocalProblem problem =
+      fclib::scene_problem(world->bodies(), world->contacts(), world->settings().dt).local;
+  const double tolerance = 1e-10 * problem.q.norm();
+  ledas::FrictionalSolver solver;
+  const LocalAnswer answer = solve_local(solver, problem, tolerance);
+  EXPECT_TRUE(answer.converged);
+  EXPECT_EQ(answer.stats.coulomb_interior_point_solved, 1u);
+  EXPECT_LE(answer.stats.coulomb_interior_point_steps, 30u);
+  expect_coulomb_with_slip(problem, answer.r, answer.u, tolerance);
+
+  ledas::FrictionalSettings without;
+  without.coulomb_interior_point_iterations = 0;
+  ledas::FrictionalSolver before(without);
+  const LocalAnswer old_answer = solve_local(before, problem, tolerance);
+  EXPECT_TRUE(old_answer.converged);
+  EXPECT_EQ(old_answer.stats.coulomb_interior_point_steps, 0u);
+  EXPECT_LE(answer.stats.newton_steps + 200, old_answer.stats.newton_steps);
+}
+
 // A standing stack of 40 boxes, each on four corners (160 contacts, μ = 0.5), given one step of gravity:
 // every contact can stick, so W r = −q on every row at once (the sticking guess, one factorization) has
 // an answer in the cones, and Newton finishes it without the interior point. Checked against Coulomb's

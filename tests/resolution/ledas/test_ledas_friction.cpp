@@ -580,11 +580,34 @@ TEST(LedasFriction, ReleasingOneContactSolvesWhereEveryStageStalls) {
   }
 }
 
+// Coulomb's law contact by contact, to the problem's tolerance: r_n ≥ 0, u_n ≥ 0, r_n u_n = 0, the
+// friction within the cone, and where a contact slides, at the cone's edge and against the slip; and the
+// natural-map residual within the tolerance.
+void expect_coulomb_law(const ledas::SparseMatrix& w, const ledas::FrictionalProblem& problem, const ledas::Vector& r,
+                        double mu) {
+  EXPECT_LE(ledas::natural_map_residual(problem, r), problem.tolerance);
+  const ledas::Vector u = w * r + problem.q;
+  const double tol = problem.tolerance;
+  for (Eigen::Index c = 0; c < r.size() / 3; ++c) {
+    const double rn = r(3 * c), un = u(3 * c), friction = r.segment(3 * c + 1, 2).norm(), slip = u.segment(3 * c + 1, 2).norm();
+    EXPECT_GE(rn, -tol) << c;
+    EXPECT_GE(un, -tol) << c;
+    EXPECT_LE(std::abs(rn * un), tol) << c;
+    EXPECT_LE(friction, mu * rn + tol) << c;
+    if (slip > 1e-6) {  // sliding: friction at the cone's edge, against the slip
+      EXPECT_NEAR(friction, mu * rn, tol) << c;
+      EXPECT_NEAR(r.segment(3 * c + 1, 2).dot(u.segment(3 * c + 1, 2)), -friction * slip, tol) << c;
+    }
+  }
+}
+
 // An island of the frictional 1,000-primitive pile (dumped from a run, values to the bit): a box on four
 // corners and a fifth contact sliding at 0.6 m/s on it, 15 rows on 12 degrees of freedom, the box's
 // contacts on the edge between sticking and slipping. Newton from the relaxation, one step of Cadoux's
 // fixed point and the proximal stages stall at 20 times the tolerance; Cadoux's fixed point carried on
 // (FrictionalSolver::solve, stage 4) solves it, and the answer obeys Coulomb's law contact by contact.
+// Since 2026-12-07 the interior point on Coulomb's problem (stage 3, 1b) lets the proximal rounds
+// finish it first.
 TEST(LedasFriction, CadouxFixedPointSolvesWhereTheStagesStall) {
   const double lower[] = {
       1.5459288839486223, -0.46288894150724758, 1.9592216012218269, -0.088499883253268186, -0.25505376286274989,
@@ -625,8 +648,11 @@ TEST(LedasFriction, CadouxFixedPointSolvesWhereTheStagesStall) {
   one_step.fixed_point_iterations = 1;
   one_step.nonsmooth_sweeps = 0;
   one_step.projection_iterations = 0;  // nor the projection stage (2026-12-06, later)
-  ledas::FrictionalSolver stalled(one_step), solver;
-  ledas::FrictionalStats stalled_stats, stats;
+  one_step.coulomb_interior_point_iterations = 0;  // nor the interior point on Coulomb's problem (2026-12-07)
+  ledas::FrictionalSettings carried_on;
+  carried_on.coulomb_interior_point_iterations = 0;
+  ledas::FrictionalSolver stalled(one_step), solver(carried_on), by_default;
+  ledas::FrictionalStats stalled_stats, stats, default_stats;
   const ledas::Vector stuck = stalled.solve(problem, stalled_stats);
   EXPECT_EQ(stalled_stats.non_converged, 1u);
   EXPECT_GT(ledas::natural_map_residual(problem, stuck), 5.0 * problem.tolerance);
@@ -634,21 +660,16 @@ TEST(LedasFriction, CadouxFixedPointSolvesWhereTheStagesStall) {
   EXPECT_EQ(stats.non_converged, 0u);
   EXPECT_GT(stats.fixed_point_steps, 1u);
   EXPECT_EQ(stats.nonsmooth_solved, 0u);
-  EXPECT_LE(ledas::natural_map_residual(problem, r), problem.tolerance);
-  const ledas::Vector u = w * r + problem.q;
-  const double tol = problem.tolerance;
-  for (int c = 0; c < 5; ++c) {
-    const double rn = r(3 * c), un = u(3 * c), friction = r.segment(3 * c + 1, 2).norm(), slip = u.segment(3 * c + 1, 2).norm();
-    EXPECT_GE(rn, -tol) << c;
-    EXPECT_GE(un, -tol) << c;
-    EXPECT_LE(std::abs(rn * un), tol) << c;
-    EXPECT_LE(friction, 0.5 * rn + tol) << c;
-    if (slip > 1e-6) {  // sliding: friction at the cone's edge, against the slip
-      EXPECT_NEAR(friction, 0.5 * rn, tol) << c;
-      EXPECT_NEAR(r.segment(3 * c + 1, 2).dot(u.segment(3 * c + 1, 2)), -friction * slip, tol) << c;
-    }
-  }
-  EXPECT_GT(u.segment(1, 2).norm(), 0.5);  // the fifth contact (first here) keeps sliding
+  expect_coulomb_law(w, problem, r, 0.5);
+  EXPECT_GT((w * r + problem.q).segment(1, 2).norm(), 0.5);  // the fifth contact (first here) keeps sliding
+  // With the defaults, the interior point on Coulomb's problem (cone_qp.hpp) runs before the proximal
+  // rounds, which then finish from its answer where they stalled before: no fixed-point step beyond
+  // the first, and an answer that obeys Coulomb's law as well.
+  const ledas::Vector by_interior_point = by_default.solve(problem, default_stats);
+  EXPECT_GT(default_stats.coulomb_interior_point_steps, 0u);
+  EXPECT_EQ(default_stats.fixed_point_steps, 1u);
+  EXPECT_EQ(default_stats.non_converged, 0u);
+  expect_coulomb_law(w, problem, by_interior_point, 0.5);
 }
 
 // The proximal stage solves the problem it is given: on the relaxation, its subproblems are relaxations

@@ -139,6 +139,15 @@ struct FrictionalSettings {
   /// that reaches this point is solved by them, so none (resolution/ledas/README.md, "Friction").
   std::uint64_t projection_stage_newton_steps = 0;
   std::uint64_t interior_point_iterations = 60;  ///< interior-point steps on the convex relaxation at most
+  /// Where Newton's first attempt on Coulomb's problem (after the relaxation and Cadoux's step) fails on
+  /// a cold problem: interior-point steps on Coulomb's problem itself (cone_qp.hpp), at most this many,
+  /// ended early when 16 do not halve the residual; the proximal rounds go on from the best answer if
+  /// they fail. 0: none.
+  std::uint64_t coulomb_interior_point_iterations = 60;
+  /// ... on problems of at most this many rows. On the dropped sphere pyramids K = 20 (1,770 rows) it
+  /// failed (24–26 steps of ~16 ms, KLU with partial pivoting), and on the frictional pile's warm-started
+  /// islands it solved 10 of some 400 problems.
+  std::size_t coulomb_interior_point_rows = 1000;
   /// Cadoux's fixed-point steps (relaxations) at most: the first before the Newton stages, the others
   /// after them if they fail (up to `fixed_point_rows`), ended when 3 steps do not halve their residual.
   std::uint64_t fixed_point_iterations = 30;
@@ -213,6 +222,9 @@ struct FrictionalStats {
   std::uint64_t newton_steps = 0;      ///< Newton steps (one factorization each, but newton_reused)
   std::uint64_t newton_reused = 0;     ///< Newton steps that reused the step before's factorization (same matrix)
   std::uint64_t interior_point_steps = 0;  ///< interior-point steps on relaxations (one factorization each)
+  /// interior-point steps on Coulomb's problem itself (FrictionalSettings::coulomb_interior_point_iterations)
+  std::uint64_t coulomb_interior_point_steps = 0;
+  std::uint64_t coulomb_interior_point_solved = 0;  ///< problems those steps solved
   /// of those, steps whose Newton system was solved in body space (FrictionalProblem::body_space)
   std::uint64_t interior_point_body_steps = 0;
   std::uint64_t proximal = 0;          ///< problems that needed the proximal stage (redundant contacts)
@@ -261,8 +273,10 @@ class FrictionalSolver {
   struct Block;  // one contact's rows (frictional_solver.cpp)
 
  private:
+  /// `interior_point`: Coulomb's problem may try the interior point after Newton (cold problems of at
+  /// most `coulomb_interior_point_rows` rows).
   double solve_stages(const FrictionalProblem& problem, Vector& r, bool warm, FrictionalStats& stats,
-                      std::uint64_t max_steps);
+                      std::uint64_t max_steps, bool interior_point = false);
   bool sticking_guess(const FrictionalProblem& problem, Vector& r, FrictionalStats& stats);
   double warm_relaxation(const FrictionalProblem& relaxed, Vector& r, FrictionalStats& stats);
   double refine(const FrictionalProblem& problem, const std::vector<Block>& blocks, Vector& r, double residual,
