@@ -139,7 +139,8 @@ void step(benchmark::State& state, const std::string& resolver_name, Scene scene
 // step (J). With friction, ledas's rows also count its frictional stages per step (friction_problems,
 // warm_solved, slips_taken, releases, relaxed, newton_steps, newton_reused (those of them that reused
 // the step before's factorization), interior_point_steps, proximal_steps, nonsmooth_sweeps,
-// nonsmooth_solved, projection_iterations, projection_solved, friction_non_converged:
+// nonsmooth_solved, projection_iterations, projection_solved, coulomb_interior_point_steps,
+// friction_non_converged:
 // ledas::FrictionalStats), and the lead-in to the snapshot as a whole (a longer, steadier measure of the
 // solver than five steps of a chaotic pile): lead_in_resolve_s, lead_in_friction_problems,
 // lead_in_non_converged.
@@ -229,6 +230,7 @@ void dynamic_step(benchmark::State& state, const std::string& resolver_name, con
     state.counters["nonsmooth_solved"] = per_step(static_cast<double>(friction.nonsmooth_solved));
     state.counters["projection_iterations"] = per_step(static_cast<double>(friction.projection_iterations));
     state.counters["projection_solved"] = per_step(static_cast<double>(friction.projection_solved));
+    state.counters["coulomb_interior_point_steps"] = per_step(static_cast<double>(friction.coulomb_interior_point_steps));
     state.counters["friction_non_converged"] = per_step(static_cast<double>(friction.non_converged));
     // The lead-in to the snapshot, whole (one thread, its first step to its last): its resolver's
     // seconds and its frictional problems left unconverged, out of how many.

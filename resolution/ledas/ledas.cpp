@@ -93,7 +93,8 @@ void LedasResolver::resolve(std::span<RigidBody> bodies, std::span<Contact> cont
   // A velocity problem without a solution (conflicting joint targets) fails the step's promise; a
   // position correction without one (a body squeezed between fixed bodies) is corrected as far as it
   // can be, and shows only in last_stats().position.infeasible.
-  counters.rounds += stats_.friction.newton_steps + stats_.friction.interior_point_steps + stats_.friction.fallback_sweeps;
+  counters.rounds += stats_.friction.newton_steps + stats_.friction.interior_point_steps +
+                     stats_.friction.coulomb_interior_point_steps + stats_.friction.fallback_sweeps;
   counters.non_converged += stats_.velocity.non_converged + stats_.velocity.infeasible + stats_.position.non_converged +
                             stats_.friction.non_converged;
   counters.natural_map_residual = std::max(counters.natural_map_residual, stats_.friction.residual);

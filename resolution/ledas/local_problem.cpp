@@ -158,6 +158,7 @@ void solve_local_problem(FrictionalSolver& solver, const LocalContactProblem& p,
   u = w * r + q_full;
   s.residual = natural_map_residual(problem, r_kept);
   s.iterations = (stats.newton_steps - before.newton_steps) + (stats.interior_point_steps - before.interior_point_steps) +
+                 (stats.coulomb_interior_point_steps - before.coulomb_interior_point_steps) +
                  (stats.fallback_sweeps - before.fallback_sweeps);
   s.converged = stats.non_converged == before.non_converged && s.residual <= p.tolerance;
 }

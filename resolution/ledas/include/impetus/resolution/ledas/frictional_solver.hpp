@@ -26,7 +26,10 @@
 ///  2. else Newton on Coulomb's problem from it, one step of Cadoux's fixed point (the relaxation with q_n
 ///     raised by μ‖u_t‖), and the Newton stages below (on a cold problem the projection below would take
 ///     next, only `projection_stage_newton_steps` of them (none by default) before it, the rest after it
-///     if it fails);
+///     if it fails); on a cold problem of at most `coulomb_interior_point_rows` rows, where the Newton
+///     stages' first attempt fails, the interior point on Coulomb's problem itself (De Saxcé's shift
+///     μ‖u_t‖ at each iterate, its derivative in the step's matrix; cone_qp.hpp) before their proximal
+///     rounds;
 ///  3. still unsolved: more of Cadoux's steps (`fixed_point_iterations`, on problems of at most
 ///     `fixed_point_rows`), then nonsmooth Gauss–Seidel sweeps from r = 0 (each contact's own problem
 ///     solved exactly in turn; at most `nonsmooth_rows`) and Newton from their iterate, or on larger
