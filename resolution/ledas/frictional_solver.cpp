@@ -1531,14 +1531,22 @@ double FrictionalSolver::solve_stages(const FrictionalProblem& problem, Vector& 
     residual = natural_map_residual(problem, r);
     warm = polish = true;
   }
+  // Where the interior point on Coulomb's problem follows (1b), Newton's first attempt is short: on the
+  // problems that interior point solves it did not converge in its 60 steps either.
+  const bool coulomb_interior_point =
+      interior_point && !problem.convex && settings_.coulomb_interior_point_iterations > 0;
   if (!likely_redundant(problem) || warm)
-    residual = newton(problem, blocks, r, polish ? settings_.polish_newton_iterations : settings_.newton_iterations, stats);
+    residual = newton(problem, blocks, r,
+                      polish                   ? settings_.polish_newton_iterations
+                      : coulomb_interior_point ? settings_.coulomb_interior_point_newton_steps
+                                               : settings_.newton_iterations,
+                      stats);
 
   // 1b. Coulomb's problem by the interior point (cone_qp.hpp), where the caller allows it: where it
   //     converges, in 10–35 steps what the proximal rounds below take hundreds of Newton steps for
   //     (the dropped pyramid K = 10 at μ = 0.5, a stack of 10 boxes); where it does not, the rounds go
   //     on from the better of its best answer and Newton's.
-  if (interior_point && !problem.convex && residual > problem.tolerance && settings_.coulomb_interior_point_iterations > 0) {
+  if (coulomb_interior_point && residual > problem.tolerance) {
     ConeQpReport report;
     Vector& answer = buffers.coulomb_answer;
     solve_cone_qp(problem, problem.tolerance, settings_.coulomb_interior_point_iterations, buffers.cone_qp,

@@ -151,6 +151,10 @@ struct FrictionalSettings {
   /// failed (24–26 steps of ~16 ms, KLU with partial pivoting), and on the frictional pile's warm-started
   /// islands it solved 10 of some 400 problems.
   std::size_t coulomb_interior_point_rows = 1000;
+  /// Newton's first attempt on such a problem, before the interior point: a few steps (60 otherwise).
+  /// On `bench_fclib`'s problems none that Newton solves there needs more than 8; on the dropped pyramid
+  /// K = 10 at μ = 0.5 the other 52 failed steps were 40% of the solve.
+  std::uint64_t coulomb_interior_point_newton_steps = 8;
   /// Cadoux's fixed-point steps (relaxations) at most: the first before the Newton stages, the others
   /// after them if they fail (up to `fixed_point_rows`), ended when 3 steps do not halve their residual.
   std::uint64_t fixed_point_iterations = 30;
