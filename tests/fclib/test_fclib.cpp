@@ -104,6 +104,15 @@ fclib::SceneProblem detected_problem(const Case& c, PluginHost& host) {
   return fclib::scene_problem(world->bodies(), world->contacts(), world->settings().dt);
 }
 
+// The dropped sphere pyramid K = 10 (pyramid_drop_10.yaml, 145 contacts) with friction μ = `mu`, its
+// contact problem after one detection.
+fclib::LocalProblem dropped_pyramid_10(PluginHost& host, const std::string& mu) {
+  const Case c{"pyramid_drop_10.yaml", {"generators.0.pyramid.friction=" + mu}, nullptr};
+  fclib::LocalProblem problem = detected_problem(c, host).local;
+  EXPECT_EQ(problem.contacts(), 145u);
+  return problem;
+}
+
 double largest(const fclib::SparseMatrix& a) { return a.nonZeros() > 0 ? a.coeffs().cwiseAbs().maxCoeff() : 0.0; }
 
 TEST(Fclib, ASceneProblemSurvivesTheFileBitForBitInBothForms) {
@@ -487,11 +496,8 @@ LocalAnswer solve_local(ledas::FrictionalSolver& solver, const fclib::LocalProbl
 TEST(Fclib, ProjectionSolvesTheDroppedPyramidK20) {
   PluginHost host;
   const Case c{"pyramid_drop_10.yaml", {"generators.0.pyramid.rows=20", "generators.0.pyramid.friction=0.5"}, nullptr};
-  std::unique_ptr<World> world = make_world(c, host);
-  world->detect_contacts();
-  ASSERT_EQ(world->contacts().size(), 590u);
-  const fclib::LocalProblem problem =
-      fclib::scene_problem(world->bodies(), world->contacts(), world->settings().dt).local;
+  const fclib::LocalProblem problem = detected_problem(c, host).local;
+  ASSERT_EQ(problem.contacts(), 590u);
   const double tolerance = 1e-10 * problem.q.norm();
   std::vector<double> r(problem.rows()), u(problem.rows());
   LocalContactSolution solution{r.data(), u.data()};
@@ -525,12 +531,7 @@ TEST(Fclib, ProjectionSolvesTheDroppedPyramidK20) {
 // against Coulomb's law contact by contact, and at least 200 Newton steps fewer than without it.
 TEST(Fclib, CoulombInteriorPointSolvesTheDroppedPyramidK10) {
   PluginHost host;
-  const Case c{"pyramid_drop_10.yaml", {"generators.0.pyramid.friction=0.5"}, nullptr};
-  std::unique_ptr<World> world = make_world(c, host);
-  world->detect_contacts();
-  ASSERT_EQ(world->contacts().size(), 145u);
-  const fclib::LocalProblem problem =
-      fclib::scene_problem(world->bodies(), world->contacts(), world->settings().dt).local;
+  const fclib::LocalProblem problem = dropped_pyramid_10(host, "0.5");
   const double tolerance = 1e-10 * problem.q.norm();
   ledas::FrictionalSolver solver;
   const LocalAnswer answer = solve_local(solver, problem, tolerance);
@@ -591,9 +592,7 @@ TEST(Fclib, TheStickingGuessSolvesAStandingStackWithoutTheInteriorPoint) {
 // finds the static equilibrium.
 TEST(Fclib, TheStickingGuessIsRefusedWhereItLeavesTheCones) {
   PluginHost host;
-  const Case c{"pyramid_drop_10.yaml", {"generators.0.pyramid.friction=0.7"}, nullptr};
-  const fclib::LocalProblem problem = detected_problem(c, host).local;
-  ASSERT_EQ(problem.contacts(), 145u);
+  const fclib::LocalProblem problem = dropped_pyramid_10(host, "0.7");
   const double tolerance = 1e-10 * problem.q.norm();
   ledas::FrictionalSolver solver;
   const LocalAnswer a = solve_local(solver, problem, tolerance);
