@@ -580,16 +580,16 @@ TEST(LedasFriction, ReleasingOneContactSolvesWhereEveryStageStalls) {
   }
 }
 
-// Coulomb's law contact by contact, to the problem's tolerance: r_n ≥ 0, u_n ≥ 0, r_n u_n = 0, the
-// friction within the cone, and where a contact slides, at the cone's edge and against the slip; and the
-// natural-map residual within the tolerance.
-void expect_coulomb_law(const ledas::SparseMatrix& w, const ledas::FrictionalProblem& problem, const ledas::Vector& r,
-                        double mu) {
+// Coulomb's law contact by contact (three rows each, μ on the normal row), to the problem's tolerance:
+// r_n ≥ 0, u_n ≥ 0, r_n u_n = 0, the friction within the cone, and where a contact slides, at the cone's
+// edge and against the slip; and the natural-map residual within the tolerance.
+void expect_coulomb_law(const ledas::SparseMatrix& w, const ledas::FrictionalProblem& problem, const ledas::Vector& r) {
   EXPECT_LE(ledas::natural_map_residual(problem, r), problem.tolerance);
   const ledas::Vector u = w * r + problem.q;
   const double tol = problem.tolerance;
   for (Eigen::Index c = 0; c < r.size() / 3; ++c) {
     const double rn = r(3 * c), un = u(3 * c), friction = r.segment(3 * c + 1, 2).norm(), slip = u.segment(3 * c + 1, 2).norm();
+    const double mu = problem.mu[static_cast<std::size_t>(3 * c)];
     EXPECT_GE(rn, -tol) << c;
     EXPECT_GE(un, -tol) << c;
     EXPECT_LE(std::abs(rn * un), tol) << c;
@@ -660,7 +660,7 @@ TEST(LedasFriction, CadouxFixedPointSolvesWhereTheStagesStall) {
   EXPECT_EQ(stats.non_converged, 0u);
   EXPECT_GT(stats.fixed_point_steps, 1u);
   EXPECT_EQ(stats.nonsmooth_solved, 0u);
-  expect_coulomb_law(w, problem, r, 0.5);
+  expect_coulomb_law(w, problem, r);
   EXPECT_GT((w * r + problem.q).segment(1, 2).norm(), 0.5);  // the fifth contact (first here) keeps sliding
   // With the defaults, the interior point on Coulomb's problem (cone_qp.hpp) runs before the proximal
   // rounds, which then finish from its answer where they stalled before: no fixed-point step beyond
@@ -669,7 +669,7 @@ TEST(LedasFriction, CadouxFixedPointSolvesWhereTheStagesStall) {
   EXPECT_GT(default_stats.coulomb_interior_point_steps, 0u);
   EXPECT_EQ(default_stats.fixed_point_steps, 1u);
   EXPECT_EQ(default_stats.non_converged, 0u);
-  expect_coulomb_law(w, problem, by_interior_point, 0.5);
+  expect_coulomb_law(w, problem, by_interior_point);
 }
 
 // The proximal stage solves the problem it is given: on the relaxation, its subproblems are relaxations
