@@ -142,8 +142,9 @@ void step(benchmark::State& state, const std::string& resolver_name, Scene scene
 // nonsmooth_solved, projection_iterations, projection_solved, coulomb_interior_point_steps,
 // friction_non_converged:
 // ledas::FrictionalStats), and the lead-in to the snapshot as a whole (a longer, steadier measure of the
-// solver than five steps of a chaotic pile): lead_in_resolve_s, lead_in_friction_problems,
-// lead_in_non_converged.
+// solver than five steps of a chaotic pile): lead_in_steps, lead_in_resolve_s, lead_in_friction_problems,
+// lead_in_non_converged, and the steps of the lead-in that left a problem unconverged with their
+// resolver seconds (lead_in_unconverged_steps, lead_in_unconverged_resolve_s).
 constexpr int kDynamicSteps = 5;
 
 const bench::DynamicStates& snapshot(const std::string& family, int n, double mu) {
@@ -234,9 +235,12 @@ void dynamic_step(benchmark::State& state, const std::string& resolver_name, con
     state.counters["friction_non_converged"] = per_step(static_cast<double>(friction.non_converged));
     // The lead-in to the snapshot, whole (one thread, its first step to its last): its resolver's
     // seconds and its frictional problems left unconverged, out of how many.
+    state.counters["lead_in_steps"] = states.lead_steps;
     state.counters["lead_in_resolve_s"] = states.lead_resolve_s;
     state.counters["lead_in_friction_problems"] = static_cast<double>(states.lead_friction_problems);
     state.counters["lead_in_non_converged"] = static_cast<double>(states.lead_friction_non_converged);
+    state.counters["lead_in_unconverged_steps"] = static_cast<double>(states.lead_unconverged_steps);
+    state.counters["lead_in_unconverged_resolve_s"] = states.lead_unconverged_resolve_s;
   }
 }
 
@@ -246,7 +250,7 @@ void register_dynamic(long max_bodies) {
     int n;
     double mu;
   };
-  const Row rows[] = {{"pile", 100, 0.0},   {"pile", 1000, 0.0},  {"pile", 1000, 0.5},
+  const Row rows[] = {{"pile", 100, 0.0},   {"pile", 1000, 0.0},  {"pile", 1000, 0.5}, {"pile_late", 1000, 0.5},
                       {"heap", 300, 0.0},   {"heap", 1000, 0.0},  {"heap", 3000, 0.0},
                       {"heap", 10000, 0.0}, {"heap", 1000, 0.5},
                       {"knocked_wall", 200, 0.0}, {"knocked_wall", 1000, 0.0}, {"pyramid", 100, 0.0},

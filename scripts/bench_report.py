@@ -329,6 +329,26 @@ def dynamic_table(rows):
     return "\n".join(lines)
 
 
+def lead_in_table(rows):
+    """bench_step's frictional dynamic rows (one thread): the lead-in to the snapshot, whole. Its resolver's
+    time per step against the timed steps', its frictional problems left unconverged, and the share of its
+    resolver's time in the steps that left one."""
+    lines = ["| Scene | Lead-in steps | Resolver, whole lead-in | Mean per step | Timed step's resolve (median) | "
+             "Frictional problems | Unconverged | Steps with one | Their share of the resolver's time |",
+             "|---|---:|---:|---:|---:|---:|---:|---:|---:|"]
+    for name, row in sorted(rows.items()):
+        m = re.match(r"step/ledas/(.+)_t1$", name)
+        if not m or "error" in row or "lead_in_unconverged_steps" not in row:
+            continue
+        steps = row["lead_in_steps"]
+        total = row["lead_in_resolve_s"]
+        share = f"{100 * row['lead_in_unconverged_resolve_s'] / total:.0f}%" if total > 0 else "—"
+        lines.append(f"| {m.group(1)} | {steps:.0f} | {seconds(total)} | {seconds(total / steps)} | "
+                     f"{seconds(row['resolve_ms'] * 1e-3)} | {row['lead_in_friction_problems']:.0f} | "
+                     f"{row['lead_in_non_converged']:.0f} | {row['lead_in_unconverged_steps']:.0f} | {share} |")
+    return "\n".join(lines) if len(lines) > 2 else ""
+
+
 def cold_table(rows):
     """bench_resolve's resolve_cold rows: the first solve of a new contact pattern against a repeated one."""
     lines = ["| Scene | Bodies | Contacts | Cold (median) | Warm (mean, same run) | Cold / warm | Analyses per cold solve |",
@@ -573,6 +593,16 @@ def main():
                 "(`World::set_threads`). *Residual* and *natural map* are the resolver's own, the largest over "
                 "the steps; *deepest* the deepest contact a detection found.", "",
                 dynamic_table(dynamic["rows"]), ""]
+        lead_in = lead_in_table(dynamic["rows"])
+        if lead_in:
+            out += ["### The frictional rows' lead-in", "",
+                    "The steps from each frictional scene's start to its snapshot (one thread, one run), whole: "
+                    "a longer measure of the frictional solver than the 5 timed steps, which start where the "
+                    "lead-in ends. A step counts under *steps with one* if it left at least one frictional "
+                    "island problem above its tolerance (its best answer is applied, and counted in the "
+                    "resolver's `non_converged`); the last column is those steps' share of the lead-in's "
+                    "resolver time.", "",
+                    lead_in, ""]
     if dynamic_peers:
         out += ["### The dynamic scenes in every engine", "",
                 "One whole step under gravity from each scene's snapshot (the heaps, the pile of 1,000 mixed "

@@ -162,6 +162,9 @@ struct DynamicScene {
 
 inline DynamicScene dynamic_scene(const std::string& family, int n, double mu) {
   if (family == "pile") return {make_pile(n, mu), 400};
+  // The same pile later, as its upper layers land on the lower ones: with friction its large islands are
+  // the frictional solver's hardest problems (resolution/ledas/README.md, "Where it fails").
+  if (family == "pile_late") return {make_pile(n, mu), 600};
   if (family == "heap") return {make_heap(n, mu), 300};
   if (family == "knocked_wall") return {make_knocked_wall(n, mu), 20};
   if (family == "pyramid") return {make_pyramid(PyramidParams{.rows = n, .velocity = Vec3::Zero(), .friction = mu}), 20};
@@ -183,11 +186,16 @@ inline void set_up_world(World& world, const std::vector<RigidBody>& bodies) {
 /// what the engine carries from step to step (warm starts, contact caches) comes from a previous step,
 /// not from nothing and not from the timed step's own answer. Throws if a step fails.
 /// The lead-in itself is measured too (one thread): its resolver's time, and ledas's frictional island
-/// problems and those left above their tolerance, summed over its steps.
+/// problems and those left above their tolerance, summed over its steps; and the steps that left at least
+/// one such problem, with their share of the resolver's time (on the frictional pile a few steps with one
+/// hard island hold most of it).
 struct DynamicStates {
   std::vector<RigidBody> before, at;
+  int lead_steps = 0;
   double lead_resolve_s = 0.0;
   std::uint64_t lead_friction_problems = 0, lead_friction_non_converged = 0;
+  std::uint64_t lead_unconverged_steps = 0;
+  double lead_unconverged_resolve_s = 0.0;  ///< the resolver's seconds in those steps
 };
 
 inline DynamicStates dynamic_states(const DynamicScene& scene) {
@@ -204,10 +212,16 @@ inline DynamicStates dynamic_states(const DynamicScene& scene) {
     if (!s.ok) throw std::runtime_error("the lead-in failed: " + s.message);
     out.lead_resolve_s += s.profile.resolve;
     if (ledas != nullptr) {
-      out.lead_friction_problems += ledas->last_stats().friction.problems;
-      out.lead_friction_non_converged += ledas->last_stats().friction.non_converged;
+      const ledas::FrictionalStats& friction = ledas->last_stats().friction;
+      out.lead_friction_problems += friction.problems;
+      out.lead_friction_non_converged += friction.non_converged;
+      if (friction.non_converged > 0) {
+        ++out.lead_unconverged_steps;
+        out.lead_unconverged_resolve_s += s.profile.resolve;
+      }
     }
   }
+  out.lead_steps = scene.lead_steps;
   out.at.assign(world.bodies().begin(), world.bodies().end());
   return out;
 }

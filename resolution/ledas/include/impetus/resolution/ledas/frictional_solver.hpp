@@ -24,7 +24,7 @@
 ///     Newton on its natural map: a static equilibrium is its answer whenever one exists, and where its
 ///     answer has no pressed contact slipping it is Coulomb's answer;
 ///  2. else Newton on Coulomb's problem from it, one step of Cadoux's fixed point (the relaxation with q_n
-///     raised by μ‖u_t‖), and the Newton stages below (on a cold problem the projection below would take
+///     raised by μ‖u_t‖; not on a warm-started problem above `fixed_point_rows`), and the Newton stages below (on a cold problem the projection below would take
 ///     next, only `projection_stage_newton_steps` of them (none by default) before it, the rest after it
 ///     if it fails); on a cold problem of at most `coulomb_interior_point_rows` rows, where the Newton
 ///     stages' first attempt fails, the interior point on Coulomb's problem itself (De Saxcé's shift
@@ -155,8 +155,9 @@ struct FrictionalSettings {
   /// On `bench_fclib`'s problems none that Newton solves there needs more than 8; on the dropped pyramid
   /// K = 10 at μ = 0.5 the other 52 failed steps were 40% of the solve.
   std::uint64_t coulomb_interior_point_newton_steps = 8;
-  /// Cadoux's fixed-point steps (relaxations) at most: the first before the Newton stages, the others
-  /// after them if they fail (up to `fixed_point_rows`), ended when 3 steps do not halve their residual.
+  /// Cadoux's fixed-point steps (relaxations) at most: the first before the Newton stages (not on a
+  /// warm-started problem above `fixed_point_rows`), the others after them if they fail (up to
+  /// `fixed_point_rows`), ended when 3 steps do not halve their residual.
   std::uint64_t fixed_point_iterations = 30;
   std::uint64_t polish_newton_iterations = 8;   ///< Newton steps on Coulomb's problem from each of them
   std::uint64_t warm_newton_iterations = 2;     ///< Newton steps from a warm start that does not solve at once
