@@ -250,7 +250,8 @@ void register_dynamic(long max_bodies) {
     int n;
     double mu;
   };
-  const Row rows[] = {{"pile", 100, 0.0},   {"pile", 1000, 0.0},  {"pile", 1000, 0.5}, {"pile_late", 1000, 0.5},
+  const Row rows[] = {{"pile", 100, 0.0},   {"pile", 1000, 0.0},  {"pile", 1000, 0.5},
+                      {"pile_late", 1000, 0.5},
                       {"heap", 300, 0.0},   {"heap", 1000, 0.0},  {"heap", 3000, 0.0},
                       {"heap", 10000, 0.0}, {"heap", 1000, 0.5},
                       {"knocked_wall", 200, 0.0}, {"knocked_wall", 1000, 0.0}, {"pyramid", 100, 0.0},

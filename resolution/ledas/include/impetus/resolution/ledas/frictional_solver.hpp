@@ -24,9 +24,10 @@
 ///     Newton on its natural map: a static equilibrium is its answer whenever one exists, and where its
 ///     answer has no pressed contact slipping it is Coulomb's answer;
 ///  2. else Newton on Coulomb's problem from it, one step of Cadoux's fixed point (the relaxation with q_n
-///     raised by μ‖u_t‖; not on a warm-started problem above `fixed_point_rows`), and the Newton stages below (on a cold problem the projection below would take
-///     next, only `projection_stage_newton_steps` of them (none by default) before it, the rest after it
-///     if it fails); on a cold problem of at most `coulomb_interior_point_rows` rows, where the Newton
+///     raised by μ‖u_t‖; not on a warm-started problem above `fixed_point_rows`), and the Newton stages
+///     below (on a cold problem the projection below would take next, only
+///     `projection_stage_newton_steps` of them (none by default) before it, the rest after it if it
+///     fails); on a cold problem of at most `coulomb_interior_point_rows` rows, where the Newton
 ///     stages' first attempt fails, the interior point on Coulomb's problem itself (De Saxcé's shift
 ///     μ‖u_t‖ at each iterate, its derivative in the step's matrix; cone_qp.hpp) before their proximal
 ///     rounds;
