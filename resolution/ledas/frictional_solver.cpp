@@ -1132,8 +1132,8 @@ void FrictionalSolver::solve(const FrictionalProblem& problem, FrictionalStats& 
     relaxation = r;
     buffers.relaxation_first = r;  // kept for the projection stage (5b): Cadoux's steps overwrite `relaxation`
     // Not on a warm-started problem above `fixed_point_rows` rows, where the steps after the stages (4) do
-    // not follow either: on 80 large islands dumped from the frictional pile (500–3,700 rows) the step
-    // was a quarter of their time, and the stages solved as many of them without it (18 of 80).
+    // not follow either: on 79 large islands dumped from the frictional pile (500–3,700 rows) the step
+    // was a quarter of their time, and the stages solved as many of them without it (18 of 79).
     const auto rows = static_cast<std::size_t>(problem.q.size());
     const bool first_fixed_point = !warm || rows <= settings_.fixed_point_rows;
     const bool more = best_residual > problem.tolerance && relaxed_residual <= relaxed.tolerance &&
