@@ -250,7 +250,7 @@ struct FrictionalWorkspace::Newton {
   // the last one's pattern allocates nothing either (where no contact slides above `dense_limit`).
   ConeQpWorkspace cone_qp;
   std::vector<Block> stage_blocks;
-  Vector stage_diagonal, stage_best, cold_best, polished, velocity, next, warm_answer, warm_copy;
+  Vector stage_diagonal, stage_best, cold_best, polished, velocity, next, over, warm_answer, warm_copy;
   FrictionalProblem relaxed, sub, exact;
   SparseMatrix shifted;
   // The nonsmooth Gauss–Seidel stage's: each block's own 3 × 3 block of W, its iterate and velocities.
@@ -927,7 +927,11 @@ double FrictionalSolver::newton(const FrictionalProblem& problem, const std::vec
 // where they started instead of running off. ε adapts: ×0.1 after a subproblem Newton solved (down to
 // the Jacobian's own shift), ×10 after one it could not (up to 0.1 max W_ii: a better conditioned
 // subproblem, a slower but surer outer iteration). Each subproblem is solved only to a fraction of the
-// current error (an inexact proximal point method), the last ones to the tolerance.
+// current error (an inexact proximal point method), the last ones to the tolerance. Each solved point is
+// over-relaxed, r̄ ← r̄ + ω (p − r̄) with ω = `proximal_relaxation` (Eckstein and Bertsekas's relaxed
+// proximal point method, which converges for ω in (0, 2) on monotone problems), unless the relaxed
+// point's residual is more than twice the point's own: where ε's shift makes the points creep, it moves
+// r̄ further per solve.
 void FrictionalSolver::proximal_newton(const FrictionalProblem& problem, const std::vector<Block>& blocks, Vector& r,
                                        FrictionalStats& stats) {
   const double scale = problem.w->diagonal().maxCoeff();
@@ -955,8 +959,17 @@ void FrictionalSolver::proximal_newton(const FrictionalProblem& problem, const s
     sub.tolerance = std::max(0.5 * problem.tolerance, 1e-3 * residual);
     next = r;
     if (newton(sub, blocks, next, settings_.proximal_newton_iterations, stats) <= sub.tolerance) {
+      // Over-relaxed (r̄ + ω (p − r̄)), unless that point's residual is more than twice the solution's.
+      residual = natural_map_residual(problem, next);
+      if (settings_.proximal_relaxation != 1.0) {
+        Vector& over = buffers_->over;
+        over = r + settings_.proximal_relaxation * (next - r);
+        if (const double now = natural_map_residual(problem, over); now <= 2.0 * residual) {
+          next.swap(over);
+          residual = now;
+        }
+      }
       r = next;
-      residual = natural_map_residual(problem, r);
       epsilon = std::max(0.1 * epsilon, floor);
     } else {
       epsilon = std::min(10.0 * epsilon, ceiling);
