@@ -929,9 +929,9 @@ double FrictionalSolver::newton(const FrictionalProblem& problem, const std::vec
 // subproblem, a slower but surer outer iteration). Each subproblem is solved only to a fraction of the
 // current error (an inexact proximal point method), the last ones to the tolerance. Each solved point is
 // over-relaxed, r̄ ← r̄ + ω (p − r̄) with ω = `proximal_relaxation` (Eckstein and Bertsekas's relaxed
-// proximal point method, which converges for ω in (0, 2) on monotone problems), unless the relaxed
-// point's residual is more than twice the point's own: where ε's shift makes the points creep, it moves
-// r̄ further per solve.
+// proximal point method, which converges for ω in (0, 2) on monotone problems), unless the point solves
+// the problem or the relaxed point's residual is more than twice the point's own: where ε's shift makes
+// the points creep, it moves r̄ further per solve.
 void FrictionalSolver::proximal_newton(const FrictionalProblem& problem, const std::vector<Block>& blocks, Vector& r,
                                        FrictionalStats& stats) {
   const double scale = problem.w->diagonal().maxCoeff();
@@ -959,9 +959,10 @@ void FrictionalSolver::proximal_newton(const FrictionalProblem& problem, const s
     sub.tolerance = std::max(0.5 * problem.tolerance, 1e-3 * residual);
     next = r;
     if (newton(sub, blocks, next, settings_.proximal_newton_iterations, stats) <= sub.tolerance) {
-      // Over-relaxed (r̄ + ω (p − r̄)), unless that point's residual is more than twice the solution's.
+      // Over-relaxed (r̄ + ω (p − r̄)), unless p solves the problem or the relaxed point's residual is more
+      // than twice p's.
       residual = natural_map_residual(problem, next);
-      if (settings_.proximal_relaxation != 1.0) {
+      if (settings_.proximal_relaxation != 1.0 && residual > problem.tolerance) {
         Vector& over = buffers_->over;
         over = r + settings_.proximal_relaxation * (next - r);
         if (const double now = natural_map_residual(problem, over); now <= 2.0 * residual) {
