@@ -20,6 +20,7 @@
 #include "support/bench_resolvers.hpp"
 #include "support/bench_scenes.hpp"
 #include "support/bench_steps.hpp"
+#include "support/machine_probe.hpp"
 
 #include "impetus/core/mass.hpp"
 #include "impetus/engine/world.hpp"
@@ -31,6 +32,7 @@
 #include <cstdlib>
 #include <map>
 #include <memory>
+#include <optional>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -156,8 +158,13 @@ const bench::DynamicStates& snapshot(const std::string& family, int n, double mu
 }
 
 void dynamic_step(benchmark::State& state, const std::string& resolver_name, const std::string& family, int n,
-                  double mu, std::uint32_t threads) {
+                  double mu, std::uint32_t threads, int cpu = -1) {
   const bench::DynamicStates& states = snapshot(family, n, mu);
+  std::optional<bench::PinnedThread> pinned;  // machine/…_cpu<k>: this thread on vCPU k only
+  if (cpu >= 0 && !pinned.emplace(cpu).ok()) {
+    state.SkipWithError(("cannot pin the thread to vCPU " + std::to_string(cpu)).c_str());
+    return;
+  }
   const std::vector<RigidBody>& start = states.at;
   World world;
   bench::set_up_world(world, start);
@@ -279,6 +286,12 @@ void register_dynamic(long max_bodies) {
         })->Unit(benchmark::kMillisecond);
       }
   }
+  // The pile's one-thread steps on each vCPU in turn (support/machine_probe.hpp).
+  if (const std::vector<int> cpus = bench::allowed_cpus(); cpus.size() > 1 && max_bodies >= 1000)
+    for (const int cpu : cpus)
+      benchmark::RegisterBenchmark(("machine/pile_1000_cpu" + std::to_string(cpu)).c_str(), [cpu](benchmark::State& st) {
+        dynamic_step(st, "ledas", "pile", 1000, 0.0, 1, cpu);
+      })->Unit(benchmark::kMillisecond);
 }
 
 int register_all() {

@@ -329,6 +329,22 @@ def dynamic_table(rows):
     return "\n".join(lines)
 
 
+def machine_table(rows):
+    """bench_step's machine/ rows (benchmarks/support/machine_probe.hpp): the pile's one-thread step pinned
+    to each vCPU. None if the run has none."""
+    lines = ["| Probe | Per step | Against the fastest |", "|---|---:|---:|"]
+    pinned = {int(m.group(1)): row for name, row in rows.items()
+              if (m := re.match(r"machine/pile_1000_cpu(\d+)$", name)) and "error" not in row}
+    fastest = min((row["step_ms"] for row in pinned.values()), default=None)
+    for cpu, row in sorted(pinned.items()):
+        lines.append(f"| pile of 1,000, one thread on vCPU {cpu} | {seconds(row['step_ms'] * 1e-3)} | "
+                     f"{row['step_ms'] / fastest:.2f}× |")
+    if len(pinned) > 1:  # each vCPU doing the share its speed allows
+        ceiling = sum(fastest / row["step_ms"] for row in pinned.values())
+        lines.append(f"| ceiling for two threads on work that splits perfectly | | {ceiling:.2f}× |")
+    return "\n".join(lines) if len(lines) > 2 else None
+
+
 def lead_in_table(rows):
     """bench_step's frictional dynamic rows (one thread): the lead-in to the snapshot, whole. Its resolver's
     time per step against the timed steps', its frictional problems left unconverged, and the share of its
@@ -598,6 +614,17 @@ def main():
                 "(`World::set_threads`). *Residual* and *natural map* are the resolver's own, the largest over "
                 "the steps; *deepest* the deepest contact a detection found.", "",
                 dynamic_table(dynamic["rows"]), ""]
+        vcpus = machine_table(dynamic["rows"])
+        if vcpus:
+            out += ["### What two threads can give on this machine", "",
+                    "The same run's `machine/` rows (`benchmarks/support/machine_probe.hpp`): the pile's "
+                    "one-thread steps with the thread pinned to each vCPU in turn. On this virtual machine one vCPU "
+                    "at times runs the scenes up to 1.3× slower than the other (which one changes over the day, "
+                    "while plain arithmetic runs alike on both), so a one-thread row runs at the speed of whichever vCPU it "
+                    "was given, and *2 threads over 1* above, against a one-thread row on the fast vCPU, is "
+                    "bounded even for work that splits perfectly: by Σ t_fast / t_k over the vCPUs k (the "
+                    "last line).", "",
+                    vcpus, ""]
         lead_in = lead_in_table(dynamic["rows"])
         if lead_in:
             out += ["### The frictional rows' lead-in", "",
