@@ -33,9 +33,10 @@ run_as() {  # run_as OUT NAME [extra args]: bench_NAME → docs/data/OUT.json
 run() { run_as "$1" "$@"; }  # run NAME [extra args]: bench_NAME → docs/data/NAME.json
 run resolve --benchmark_filter='^resolve/'
 run_as resolve_cold resolve --benchmark_filter='^resolve_cold/'
-# The dynamic scenes' rows (…_t1, …_t2) go to their own file: they run long (a 10,000-sphere heap).
-run step --benchmark_filter='-_t[0-9]+$'
-run_as dynamic step --benchmark_filter='_t[0-9]+$'
+# The dynamic scenes' rows (…_t1, …_t2) go to their own file: they run long (a 10,000-sphere heap). With
+# them, the machine/ rows: the pile's one-thread steps on each vCPU (benchmarks/support/machine_probe.hpp).
+run step --benchmark_filter='-(_t[0-9]+$|^machine/)'
+run_as dynamic step --benchmark_filter='_t[0-9]+$|^machine/'
 run detect
 run model
 if [ -x "$build/bin/bench_peers" ]; then

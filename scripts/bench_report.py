@@ -341,7 +341,7 @@ def machine_table(rows):
                      f"{row['step_ms'] / fastest:.2f}× |")
     if len(pinned) > 1:  # each vCPU doing the share its speed allows
         ceiling = sum(fastest / row["step_ms"] for row in pinned.values())
-        lines.append(f"| ceiling for two threads on work that splits perfectly | | {ceiling:.2f}× |")
+        lines.append(f"| ceiling for {len(pinned)} threads on work that splits perfectly | | {ceiling:.2f}× |")
     return "\n".join(lines) if len(lines) > 2 else None
 
 
