@@ -136,7 +136,8 @@ void step(benchmark::State& state, const std::string& resolver_name, Scene scene
 // steps from there, so the contact pattern changes from step to step and every warm start comes from the
 // previous step, never from a timed step's own answer in an earlier iteration (bench_peers times its
 // dynamic rows the same way, one step). Counters are per step: step_ms and the stages,
-// contacts, islands, rounds; residual, natural_map and penetration (deepest contact a detection found)
+// contacts, islands, rounds, ledas's symbolic analyses (analyses: new patterns; analyses_reused: cached
+// ones); residual, natural_map and penetration (deepest contact a detection found)
 // are the largest over the steps, and energy_change the kinetic energy the resolve stage changed per
 // step (J). With friction, ledas's rows also count its frictional stages per step (friction_problems,
 // warm_solved, slips_taken, releases, relaxed, newton_steps, newton_reused (those of them that reused
@@ -172,6 +173,7 @@ void dynamic_step(benchmark::State& state, const std::string& resolver_name, con
   world.set_threads(threads);
   StepProfile sum;
   double contacts = 0, islands = 0, rounds = 0, energy = 0, residual = 0, natural_map = 0, penetration = 0;
+  double analyses = 0, reused = 0;  // ledas's symbolic analyses (impacts and corrections)
   for (auto _ : state) {
     state.PauseTiming();
     std::shared_ptr<CollisionResolver> resolver = bench::make_resolver(resolver_name, /*velocity_only=*/false);
@@ -203,7 +205,12 @@ void dynamic_step(benchmark::State& state, const std::string& resolver_name, con
       residual = std::max(residual, s.resolver.residual);
       natural_map = std::max(natural_map, s.resolver.natural_map_residual);
       for (const Contact& c : world.contacts()) penetration = std::max(penetration, c.depth);
-      if (ledas != nullptr) ledas::add(friction, ledas->last_stats().friction);
+      if (ledas != nullptr) {
+        const LedasStats& stats = ledas->last_stats();
+        ledas::add(friction, stats.friction);
+        analyses += static_cast<double>(stats.velocity.symbolic_analyses + stats.position.symbolic_analyses);
+        reused += static_cast<double>(stats.velocity.symbolic_reused + stats.position.symbolic_reused);
+      }
       state.ResumeTiming();
     }
   }
@@ -219,6 +226,12 @@ void dynamic_step(benchmark::State& state, const std::string& resolver_name, con
   state.counters["energy_change"] = per_step(energy);
   state.counters["residual"] = residual;
   state.counters["penetration"] = penetration;
+  if (resolver_name.starts_with("ledas")) {
+    // The sparse factorizations' symbolic analyses per step (the impacts' and the corrections'): new
+    // patterns analysed, and patterns met before whose cached analysis was reused.
+    state.counters["analyses"] = per_step(analyses);
+    state.counters["analyses_reused"] = per_step(reused);
+  }
   if (resolver_name.starts_with("ledas") && mu > 0) {
     state.counters["natural_map"] = natural_map;
     // Where the frictional solver's time goes, per step: its island problems, those their warm start
