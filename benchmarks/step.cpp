@@ -136,8 +136,8 @@ void step(benchmark::State& state, const std::string& resolver_name, Scene scene
 // steps from there, so the contact pattern changes from step to step and every warm start comes from the
 // previous step, never from a timed step's own answer in an earlier iteration (bench_peers times its
 // dynamic rows the same way, one step). Counters are per step: step_ms and the stages,
-// contacts, islands, rounds, ledas's symbolic analyses (analyses: new patterns; analyses_reused: cached
-// ones); residual, natural_map and penetration (deepest contact a detection found)
+// contacts, islands, rounds, allocations (heap allocations), ledas's symbolic analyses (analyses: new
+// patterns; analyses_reused: cached ones); residual, natural_map and penetration (deepest contact a detection found)
 // are the largest over the steps, and energy_change the kinetic energy the resolve stage changed per
 // step (J). With friction, ledas's rows also count its frictional stages per step (friction_problems,
 // warm_solved, slips_taken, releases, relaxed, newton_steps, newton_reused (those of them that reused
@@ -174,6 +174,7 @@ void dynamic_step(benchmark::State& state, const std::string& resolver_name, con
   StepProfile sum;
   double contacts = 0, islands = 0, rounds = 0, energy = 0, residual = 0, natural_map = 0, penetration = 0;
   double analyses = 0, reused = 0;  // ledas's symbolic analyses (impacts and corrections)
+  std::uint64_t allocations = 0;     // heap allocations in the timed steps (allocation_counter.hpp)
   for (auto _ : state) {
     state.PauseTiming();
     std::shared_ptr<CollisionResolver> resolver = bench::make_resolver(resolver_name, /*velocity_only=*/false);
@@ -187,7 +188,9 @@ void dynamic_step(benchmark::State& state, const std::string& resolver_name, con
     bench::restore_state(world.bodies(), start);
     state.ResumeTiming();
     for (int i = 0; i < kDynamicSteps; ++i) {
+      const std::uint64_t allocated_before = bench::allocations();
       const StepStatus& s = world.step();
+      allocations += bench::allocations() - allocated_before;
       state.PauseTiming();
       if (!s.ok) {
         state.SkipWithError(s.message.c_str());
@@ -226,6 +229,7 @@ void dynamic_step(benchmark::State& state, const std::string& resolver_name, con
   state.counters["energy_change"] = per_step(energy);
   state.counters["residual"] = residual;
   state.counters["penetration"] = penetration;
+  state.counters["allocations"] = per_step(static_cast<double>(allocations));
   if (resolver_name.starts_with("ledas")) {
     // The sparse factorizations' symbolic analyses per step (the impacts' and the corrections'): new
     // patterns analysed, and patterns met before whose cached analysis was reused.
