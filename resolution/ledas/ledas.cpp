@@ -12,6 +12,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <numeric>
 #include <span>
 #include <string>
 #include <utility>
@@ -52,6 +53,13 @@ LedasResolver::LedasResolver(const LedasSettings& settings) : settings_(settings
 }()) {}
 
 LedasResolver::~LedasResolver() = default;
+
+// A body's lane: the top bits of its index times 2⁶⁴/φ (Fibonacci hashing), so that neighbouring
+// indices, as a pile's or a heap's islands have, spread over the lanes.
+std::size_t LedasResolver::lane_of(BodyIndex body) {
+  static_assert(kLanes == 256, "the shift below takes log2(kLanes) bits");
+  return static_cast<std::size_t>((std::uint64_t{body} * 0x9E3779B97F4A7C15ULL) >> 56);
+}
 
 LedasResolver::Lane& LedasResolver::lane(std::size_t index) {
   if (lanes_.size() <= index) lanes_.resize(index + 1);
@@ -138,11 +146,27 @@ void LedasResolver::resolve_all(std::span<RigidBody> bodies, std::span<Contact> 
   resolution::find_islands(rows_, bodies.size(), bodies, islands_);
   body_slot_.assign(bodies.size(), -1);
   if (!settings_.islands) islands_.merge();  // one system for everything (benchmarks/model.cpp)
-  // Island i goes to lane i mod kLanes; the lanes run in parallel (in the caller's thread arena: the
-  // world's `threads`), each on its islands in order. Islands share no movable body, so they write
-  // disjoint bodies, contacts and body slots; everything else a lane writes is its own.
-  const std::size_t used = std::min(islands_.size(), kLanes);
-  for (std::size_t k = 0; k < used; ++k) {
+  // Each island goes to a lane by its first row's lower movable body (a hash of that body's index: see
+  // lane_of), and the lanes run in parallel (in the caller's thread arena: the world's `threads`), each
+  // on its islands in order. Islands share no movable body, so they write disjoint bodies, contacts and
+  // body slots; everything else a lane writes is its own.
+  const std::size_t n = islands_.size();
+  lane_start_.assign(kLanes + 1, 0);
+  island_lane_.resize(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    const resolution::ImpulseRow& first = rows_[islands_.island(i).front()];
+    const BodyIndex body = bodies[first.a].fixed ? first.b : bodies[first.b].fixed ? first.a : std::min(first.a, first.b);
+    island_lane_[i] = lane_of(body);
+    ++lane_start_[island_lane_[i] + 1];
+  }
+  std::partial_sum(lane_start_.begin(), lane_start_.end(), lane_start_.begin());
+  lane_islands_.resize(n);
+  lane_next_.assign(lane_start_.begin(), lane_start_.end() - 1);
+  for (std::size_t i = 0; i < n; ++i) lane_islands_[lane_next_[island_lane_[i]]++] = i;  // each lane's increasing
+  lane_order_.clear();
+  for (std::size_t k = 0; k < kLanes; ++k) {
+    if (lane_start_[k] == lane_start_[k + 1]) continue;
+    lane_order_.push_back(k);
     Lane& l = lane(k);
     l.stats = LedasStats{};
     l.counters = ResolverCounters{};
@@ -153,27 +177,27 @@ void LedasResolver::resolve_all(std::span<RigidBody> bodies, std::span<Contact> 
   // a pile's one large island then starts at once instead of after the small ones dealt before it, and
   // the other threads take the small ones and its position correction (solve_island) alongside. Only
   // the schedule changes: each lane still solves its own islands in order.
-  lane_order_.resize(used);
-  lane_load_.assign(used, 0.0);
-  for (std::size_t i = 0; i < islands_.size(); ++i) {
+  lane_load_.assign(kLanes, 0.0);
+  for (std::size_t i = 0; i < n; ++i) {
     const auto rows = static_cast<double>(islands_.island(i).size());
-    lane_load_[i % kLanes] += rows * rows;
+    lane_load_[island_lane_[i]] += rows * rows;
   }
-  for (std::size_t k = 0; k < used; ++k) lane_order_[k] = k;
   std::sort(lane_order_.begin(), lane_order_.end(), [&](std::size_t x, std::size_t y) {
     return lane_load_[x] > lane_load_[y] || (lane_load_[x] == lane_load_[y] && x < y);
   });
+  const std::size_t used = lane_order_.size();
   const auto run_lanes = [&](const tbb::blocked_range<std::size_t>& range) {
     for (std::size_t j = range.begin(); j != range.end(); ++j) {
       const std::size_t k = lane_order_[j];
-      for (std::size_t i = k; i < islands_.size(); i += kLanes)
-        solve_island(islands_.island(i), bodies, contacts, ctx.dt, *lanes_[k]);
+      for (std::size_t q = lane_start_[k]; q < lane_start_[k + 1]; ++q)
+        solve_island(islands_.island(lane_islands_[q]), bodies, contacts, ctx.dt, *lanes_[k]);
     }
   };
   if (used > 1) tbb::parallel_for(tbb::blocked_range<std::size_t>(0, used, 1), run_lanes, tbb::simple_partitioner());
   else run_lanes(tbb::blocked_range<std::size_t>(0, used, 1));
   // The lanes' results in lane order: the same sums whatever thread ran which lane.
-  for (std::size_t k = 0; k < used; ++k) {
+  for (std::size_t k = 0; k < kLanes; ++k) {
+    if (lane_start_[k] == lane_start_[k + 1]) continue;
     const Lane& l = *lanes_[k];
     add(stats_, l.stats);
     add(counters, l.counters);

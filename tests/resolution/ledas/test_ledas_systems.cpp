@@ -195,6 +195,49 @@ TEST(LedasSystems, BoxOnFivePointsSharesEqually) {
   }
 }
 
+// Islands go to the resolver's lanes by a body of theirs, not by their place in the list: the pyramid K =
+// 20 resolved again after a new island appeared before it (two spheres far away, one falling onto the
+// other, whose contact is listed first) finds its cached symbolic analysis (dealt by index, it moved to
+// the next lane, which had none), and its bodies get the same velocities, to the bit, as without the
+// new island.
+TEST(LedasSystems, AnIslandKeepsItsAnalysisWhenAnotherAppearsBeforeIt) {
+  const std::vector<RigidBody> pyramid = pyramid_of(20);
+  LedasSettings settings = touching_start();
+  settings.solver.dense_limit = 8;
+  LedasResolver resolver(settings);
+  std::vector<RigidBody> alone = pyramid;
+  std::vector<Contact> contacts = sphere_contacts(alone);
+  resolve(resolver, alone, contacts);
+  ASSERT_GT(resolver.last_stats().velocity.symbolic_analyses, 0u);
+
+  std::vector<RigidBody> bodies = pyramid;
+  const auto sphere = std::find_if(pyramid.begin(), pyramid.end(),
+                                   [](const RigidBody& b) { return !b.fixed && std::holds_alternative<Sphere>(b.shape); });
+  ASSERT_NE(sphere, pyramid.end());
+  const double r = std::get<Sphere>(sphere->shape).radius;
+  RigidBody low = *sphere, high = *sphere;
+  low.position = Vec3(1000.0, 0.0, 500.0);
+  low.velocity = Vec3::Zero();
+  high.position = low.position + Vec3(0.0, 0.0, 2.0 * r);
+  high.velocity = Vec3(0.0, 0.0, -1.0);
+  bodies.push_back(low);
+  bodies.push_back(high);
+  const auto new_body = static_cast<BodyIndex>(pyramid.size());
+  contacts = sphere_contacts(bodies);
+  std::stable_partition(contacts.begin(), contacts.end(), [&](const Contact& c) { return c.a >= new_body; });
+  ASSERT_EQ(contacts.front().a, new_body);
+  resolve(resolver, bodies, contacts);
+  EXPECT_EQ(resolver.last_stats().velocity.symbolic_analyses, 0u);
+  EXPECT_GT(resolver.last_stats().velocity.symbolic_reused, 0u);
+  for (std::size_t i = 0; i < pyramid.size(); ++i) {
+    EXPECT_EQ(bodies[i].velocity, alone[i].velocity) << "body " << i;
+    EXPECT_EQ(bodies[i].angular_velocity, alone[i].angular_velocity) << "body " << i;
+  }
+  // The new pair: a head-on inelastic impact of equal masses, 0.5 m/s each after it.
+  EXPECT_NEAR(bodies[new_body].velocity.z(), -0.5, 1e-12);
+  EXPECT_NEAR(bodies[new_body + 1].velocity.z(), -0.5, 1e-12);
+}
+
 // Pyramid K = 20 (rank-deficient: 590 contacts on 420 in-plane degrees of freedom), started with every
 // touching contact so that the search meets the redundant rows, with and without the minimum-norm polish
 // of the complementary mode (tried on final systems of at most dense_limit rows: 100000 vs 8): the same

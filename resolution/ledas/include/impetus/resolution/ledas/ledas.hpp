@@ -113,12 +113,14 @@ class LedasResolver final : public CollisionResolver {
 
  private:
   // One worker's solvers, statistics and scratch (lane.hpp). The islands of a step are dealt to the
-  // lanes by their index (island i to lane i mod kLanes) and the lanes run in parallel, each on its
-  // islands in order; a lane's caches (symbolic analyses) thus see the same islands in the same order
-  // whatever the number of threads, and the lanes' statistics are added up in lane order, so the results
-  // are bit-identical for every thread count.
+  // lanes by a body of theirs (lane_of: the lower movable body of an island's first row) and the lanes
+  // run in parallel, each on its islands in order; a lane's caches (symbolic analyses) thus see the same
+  // islands in the same order whatever the number of threads, and the lanes' statistics are added up in
+  // lane order, so the results are bit-identical for every thread count. Dealt by a body rather than by
+  // the island's index, an island that persists stays in its lane from step to step, where its last
+  // pattern's analysis is cached and its buffers have its sizes, when islands appear or vanish before it.
   struct Lane;
-  static constexpr std::size_t kLanes = 64;
+  static constexpr std::size_t kLanes = 256;
 
   // The stages of one resolve(), each in its own file: ledas.cpp (rows, islands, report), island.cpp
   // (an island's system), paper_rounds.cpp, complementary_impact.cpp, restitution.cpp,
@@ -152,12 +154,16 @@ class LedasResolver final : public CollisionResolver {
   void apply_correction(ledas::Island& island, std::span<RigidBody> bodies, Lane& lane);
   void velocity_phase(ledas::Island& island, std::span<RigidBody> bodies, std::span<Contact> contacts, Lane& lane);
   Lane& lane(std::size_t index);
+  static std::size_t lane_of(BodyIndex body);
 
   LedasSettings settings_;
   ledas::SolverSettings solver_settings_;     // the lanes' island solvers'
   std::vector<std::unique_ptr<Lane>> lanes_;  // created when first used
   std::vector<std::size_t> lane_order_;        // this step's lanes, heaviest first (resolve_all)
   std::vector<double> lane_load_;
+  // This step's dealing: each island's lane, and the islands by lane (lane k's in lane_islands_
+  // [lane_start_[k], lane_start_[k + 1]), increasing); lane_next_ is the fill's cursor.
+  std::vector<std::size_t> island_lane_, lane_start_, lane_islands_, lane_next_;
   ledas::FrictionalSolver friction_solver_;   // solve_contact_problem's
   LedasStats stats_;
   std::vector<resolution::ImpulseRow> rows_;  // this step's rows: contacts first, then joint rows
