@@ -137,8 +137,8 @@ void step(benchmark::State& state, const std::string& resolver_name, Scene scene
 // previous step, never from a timed step's own answer in an earlier iteration (bench_peers times its
 // dynamic rows the same way, one step). Counters are per step: step_ms and the stages,
 // contacts, islands, rounds, allocations (heap allocations), ledas's symbolic analyses (analyses: new
-// patterns; analyses_reused: cached ones); residual, natural_map and penetration (deepest contact a detection found)
-// are the largest over the steps, and energy_change the kinetic energy the resolve stage changed per
+// patterns; analyses_reused: cached ones); residual, natural_map and penetration (deepest contact a
+// detection found) are the largest over the steps, and energy_change the kinetic energy the resolve stage changed per
 // step (J). With friction, ledas's rows also count its frictional stages per step (friction_problems,
 // warm_solved, slips_taken, releases, relaxed, newton_steps, newton_reused (those of them that reused
 // the step before's factorization), interior_point_steps, proximal_steps, nonsmooth_sweeps,

@@ -150,19 +150,26 @@ void LedasResolver::resolve_all(std::span<RigidBody> bodies, std::span<Contact> 
   // lane_of), and the lanes run in parallel (in the caller's thread arena: the world's `threads`), each
   // on its islands in order. Islands share no movable body, so they write disjoint bodies, contacts and
   // body slots; everything else a lane writes is its own.
+  // Each lane's load (Σ rows² of its islands, as a solve's cost grows faster than its rows) is counted
+  // on the way, for the schedule below.
   const std::size_t n = islands_.size();
   lane_start_.assign(kLanes + 1, 0);
+  lane_load_.assign(kLanes, 0.0);
   island_lane_.resize(n);
   for (std::size_t i = 0; i < n; ++i) {
-    const resolution::ImpulseRow& first = rows_[islands_.island(i).front()];
-    const BodyIndex body = bodies[first.a].fixed ? first.b : bodies[first.b].fixed ? first.a : std::min(first.a, first.b);
-    island_lane_[i] = lane_of(body);
-    ++lane_start_[island_lane_[i] + 1];
+    const std::span<const std::uint32_t> island = islands_.island(i);
+    const resolution::ImpulseRow& first = rows_[island.front()];
+    const BodyIndex body =
+        bodies[first.a].fixed ? first.b : bodies[first.b].fixed ? first.a : std::min(first.a, first.b);
+    const std::size_t k = lane_of(body);
+    island_lane_[i] = k;
+    ++lane_start_[k + 1];
+    lane_load_[k] += static_cast<double>(island.size()) * static_cast<double>(island.size());
   }
   std::partial_sum(lane_start_.begin(), lane_start_.end(), lane_start_.begin());
   lane_islands_.resize(n);
   lane_next_.assign(lane_start_.begin(), lane_start_.end() - 1);
-  for (std::size_t i = 0; i < n; ++i) lane_islands_[lane_next_[island_lane_[i]]++] = i;  // each lane's increasing
+  for (std::size_t i = 0; i < n; ++i) lane_islands_[lane_next_[island_lane_[i]]++] = i;  // increasing per lane
   lane_order_.clear();
   for (std::size_t k = 0; k < kLanes; ++k) {
     if (lane_start_[k] == lane_start_[k + 1]) continue;
@@ -173,15 +180,9 @@ void LedasResolver::resolve_all(std::span<RigidBody> bodies, std::span<Contact> 
     l.remembered.clear();
     l.islands_used = 0;
   }
-  // Heaviest lanes first (load: Σ rows² of their islands, as a solve's cost grows faster than its rows):
-  // a pile's one large island then starts at once instead of after the small ones dealt before it, and
-  // the other threads take the small ones and its position correction (solve_island) alongside. Only
-  // the schedule changes: each lane still solves its own islands in order.
-  lane_load_.assign(kLanes, 0.0);
-  for (std::size_t i = 0; i < n; ++i) {
-    const auto rows = static_cast<double>(islands_.island(i).size());
-    lane_load_[island_lane_[i]] += rows * rows;
-  }
+  // Heaviest lanes first: a pile's one large island then starts at once instead of after the small ones
+  // dealt before it, and the other threads take the small ones and its position correction
+  // (solve_island) alongside. Only the schedule changes: each lane still solves its own islands in order.
   std::sort(lane_order_.begin(), lane_order_.end(), [&](std::size_t x, std::size_t y) {
     return lane_load_[x] > lane_load_[y] || (lane_load_[x] == lane_load_[y] && x < y);
   });

@@ -5,6 +5,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cstdio>
 #include <random>
 
@@ -211,8 +212,9 @@ TEST(LedasSystems, AnIslandKeepsItsAnalysisWhenAnotherAppearsBeforeIt) {
   ASSERT_GT(resolver.last_stats().velocity.symbolic_analyses, 0u);
 
   std::vector<RigidBody> bodies = pyramid;
-  const auto sphere = std::find_if(pyramid.begin(), pyramid.end(),
-                                   [](const RigidBody& b) { return !b.fixed && std::holds_alternative<Sphere>(b.shape); });
+  const auto sphere = std::find_if(pyramid.begin(), pyramid.end(), [](const RigidBody& b) {
+    return !b.fixed && std::holds_alternative<Sphere>(b.shape);
+  });
   ASSERT_NE(sphere, pyramid.end());
   const double r = std::get<Sphere>(sphere->shape).radius;
   RigidBody low = *sphere, high = *sphere;
@@ -233,7 +235,7 @@ TEST(LedasSystems, AnIslandKeepsItsAnalysisWhenAnotherAppearsBeforeIt) {
     EXPECT_EQ(bodies[i].velocity, alone[i].velocity) << "body " << i;
     EXPECT_EQ(bodies[i].angular_velocity, alone[i].angular_velocity) << "body " << i;
   }
-  // The new pair: a head-on inelastic impact of equal masses, 0.5 m/s each after it.
+  // The new pair: a head-on impact of equal masses with e = 0 (the pyramid's), 0.5 m/s each after it.
   EXPECT_NEAR(bodies[new_body].velocity.z(), -0.5, 1e-12);
   EXPECT_NEAR(bodies[new_body + 1].velocity.z(), -0.5, 1e-12);
 }

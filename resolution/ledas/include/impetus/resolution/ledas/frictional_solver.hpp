@@ -212,8 +212,8 @@ struct FrictionalSettings {
   std::uint64_t proximal_iterations = 40; ///< proximal points per round at most
   /// Each solved proximal point p moves r̄ to r̄ + ω (p − r̄) (1: to p), unless p solves the problem or that
   /// point's residual is more than twice p's. ω in (0, 2): the range where the relaxed proximal point
-  /// method converges on monotone problems (Eckstein and Bertsekas). On the frictional pile's first 500 steps 1.5 left 65
-  /// problems unconverged of ~34,100 instead of 75, the worst at 1.4e-4 instead of 9.4e-3.
+  /// method converges on monotone problems (Eckstein and Bertsekas). On the frictional pile's first 500
+  /// steps 1.5 left 65 problems unconverged of ~34,100 instead of 75, the worst at 1.4e-4 instead of 9.4e-3.
   double proximal_relaxation = 1.5;
   /// Newton steps per proximal point: near a solution Newton converges in a few; more means it is not
   /// near one yet, and Gauss–Seidel sweeps take over again.
