@@ -172,12 +172,19 @@ void system_values(const BodySpace& body, const Vector& d, BodySpaceWorkspace& w
     const Row ga(body.jacobian[k].data()), gb(body.jacobian[k].data() + 6);
     const double dk = d(static_cast<Eigen::Index>(k));
     const auto& at = work.offsets[k];
-    const auto block = [&work](SparseIndex i) -> Block& { return work.system[static_cast<std::size_t>(i)]; };
-    block(at[0]).noalias() += (dk * ga) * ga.transpose();
+    // Block (s, t) += (d_k g_s) g_tᵀ, written out: Eigen's outer product of an expression went through
+    // its general kernel, 8% of the knocked wall's step (the same products, the same bits).
+    const auto add_outer = [&work](SparseIndex i, const Eigen::Matrix<double, 6, 1>& s, const Row& g) {
+      Block& block = work.system[static_cast<std::size_t>(i)];
+      for (int column = 0; column < 6; ++column) block.col(column) += g(column) * s;
+    };
+    const Eigen::Matrix<double, 6, 1> da = dk * ga;
+    add_outer(at[0], da, ga);
     if (b < 0) continue;
-    block(at[1]).noalias() += (dk * ga) * gb.transpose();
-    block(at[2]).noalias() += (dk * gb) * ga.transpose();
-    block(at[3]).noalias() += (dk * gb) * gb.transpose();
+    const Eigen::Matrix<double, 6, 1> db = dk * gb;
+    add_outer(at[1], da, gb);
+    add_outer(at[2], db, ga);
+    add_outer(at[3], db, gb);
   }
 }
 
