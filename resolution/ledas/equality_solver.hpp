@@ -29,7 +29,8 @@ class EqualitySolver {
   /// Solves one system m p = rhs by the cheapest exact method: closed form, dense, or sparse LDLᵀ;
   /// minimum-norm least squares when m is rank-deficient.
   Vector solve_system(const SparseMatrix& m, const Vector& rhs, SolverStats& stats);
-  /// Dense LDLᵀ with diagonal pivoting; minimum-norm least squares (eigen-decomposition) when singular.
+  /// Dense LDLᵀ with diagonal pivoting; minimum-norm least squares when singular (from that LDLᵀ's rank
+  /// factorization, or by the eigen-decomposition where that answer fails its check).
   Vector solve_dense_matrix(const Eigen::MatrixXd& a, const Vector& rhs, SolverStats& stats);
   /// The same into `p`, factorizing in `ldlt`: with both sized by an earlier call of the same size, the
   /// regular case allocates nothing (the singular one does).
@@ -50,6 +51,8 @@ class EqualitySolver {
   void solve_component(const SparseMatrix& a, const Vector& c, std::span<const RowIndex> subset, int root, Vector& p,
                        SolverStats& stats);
   Vector solve_sparse(const SparseMatrix& m, const Vector& rhs, double pivot_floor, SolverStats& stats);
+  bool minimum_norm_from_ldlt(const Eigen::MatrixXd& a, const Eigen::LDLT<Eigen::MatrixXd>& ldlt, const Vector& rhs,
+                              double pivot_floor, Vector& p);
   FactorPtr checkout(const SparseMatrix& m, SolverStats& stats);
   void checkin(FactorPtr factor);
 
@@ -57,6 +60,8 @@ class EqualitySolver {
     std::vector<int> slot, parent, start, fill, members;  // subset components
     Eigen::MatrixXd dense;
     Vector rhs;
+    Eigen::MatrixXd rank_factor, gram;  // solve_dense_matrix's minimum-norm solve: L_R and L_Rᵀ L_R
+    Vector pivots, permuted, reduced, candidate, residual;
   };
   const SolverSettings& settings_;
   std::vector<FactorPtr> cache_;  // sparse factorizations by pattern, least recently used first

@@ -10,9 +10,9 @@
 ///  - up to `dense_limit` rows: dense LDLᵀ with diagonal pivoting (rank-revealing for a PSD matrix);
 ///  - more rows: sparse LDLᵀ (Eigen SimplicialLDLT, AMD ordering; symbolic analysis cached by pattern);
 ///  - a rank-deficient block (a pivot ≤ rank_tolerance · max A_ii: redundant contacts, the paper's
-///    Figure 2) gets the minimum-norm least-squares solution, as the paper prescribes: dense by the
-///    eigen-decomposition (the SVD of a symmetric PSD matrix), sparse by projecting out a null-space
-///    basis found by shifted inverse iteration.
+///    Figure 2) gets the minimum-norm least-squares solution, as the paper prescribes: dense from the
+///    pivoted LDLᵀ's rank factorization (checked; else the eigen-decomposition, the SVD of a symmetric
+///    PSD matrix), sparse by projecting out a null-space basis found by shifted inverse iteration.
 ///
 /// Complementarity (the complementary mode, the position correction): a proximal-point iteration whose
 /// subproblems have the positive definite matrix A + εI, each solved by block principal pivoting then
