@@ -317,15 +317,19 @@ def dynamic_table(rows):
         if m and "error" not in row:
             by_key[(m.group(2), m.group(1), int(m.group(3)))] = row
     lines = ["| Scene | Resolver | Threads | Bodies | Contacts | Islands | Step (median) | detect | resolve | "
-             "2 threads over 1 | Residual (m/s) | Natural map | Deepest (m) |",
-             "|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|"]
+             "2 threads over 1 | Residual (m/s) | Natural map | Deepest (m) | Analyses new / reused | Allocations |",
+             "|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|"]
     for (scene, resolver, threads), row in sorted(by_key.items()):
         one = by_key.get((scene, resolver, 1))
         ratio = f"{one['step_ms'] / row['step_ms']:.2f}×" if threads == 2 and one else ""
         ms = lambda k: seconds(row[k] * 1e-3)
+        analyses = (f"{row['analyses']:.0f} / {row['analyses_reused']:.0f}"
+                    if "analyses" in row and "analyses_reused" in row else "—")
+        allocations = f"{row['allocations']:,.0f}" if "allocations" in row else "—"
         lines.append(f"| {scene} | {resolver} | {threads} | {row['bodies']:.0f} | {row['contacts']:.0f} | "
                      f"{row['islands']:.0f} | {ms('step_ms')} | {ms('detect_ms')} | {ms('resolve_ms')} | {ratio} | "
-                     f"{sci(row.get('residual'))} | {sci(row.get('natural_map'))} | {sci(row.get('penetration'))} |")
+                     f"{sci(row.get('residual'))} | {sci(row.get('natural_map'))} | {sci(row.get('penetration'))} | "
+                     f"{analyses} | {allocations} |")
     return "\n".join(lines)
 
 
@@ -612,7 +616,10 @@ def main():
                 "cached analysis comes from an earlier step of the same run, as in a simulation (never from an "
                 "earlier iteration's timed steps); the figures are per step, wall time, with 1 and 2 threads "
                 "(`World::set_threads`). *Residual* and *natural map* are the resolver's own, the largest over "
-                "the steps; *deepest* the deepest contact a detection found.", "",
+                "the steps; *deepest* the deepest contact a detection found. *Analyses* are `ledas`'s symbolic "
+                "analyses per step (impacts and position corrections): new patterns analysed, and patterns "
+                "found in a lane's cache; *allocations* the heap allocations per step (libraries included; "
+                "benchmarks/README.md).", "",
                 dynamic_table(dynamic["rows"]), ""]
         vcpus = machine_table(dynamic["rows"])
         if vcpus:
