@@ -235,8 +235,9 @@ bool EqualitySolver::minimum_norm_from_ldlt(const Eigen::MatrixXd& a, const Eige
     for (Eigen::Index i = j + 1; i < n; ++i) l(i, column) = compact(i, j);
     pivots(column++) = d(j);
   }
-  work_.gram.noalias() = l.transpose() * l;
-  const Eigen::LLT<Eigen::MatrixXd> gram(work_.gram);
+  Eigen::LLT<Eigen::MatrixXd>& gram = work_.gram;
+  work_.gram_matrix.noalias() = l.transpose() * l;
+  gram.compute(work_.gram_matrix);
   if (gram.info() != Eigen::Success) return false;
   Vector& permuted = work_.permuted;
   permuted = ldlt.transpositionsP() * rhs;  // P c
@@ -254,7 +255,9 @@ bool EqualitySolver::minimum_norm_from_ldlt(const Eigen::MatrixXd& a, const Eige
   const double size = a.diagonal().maxCoeff();
   const double rounding = kNormalEquationsRoundoff * static_cast<double>(n) * size *
                           (size * candidate.lpNorm<Eigen::Infinity>() + rhs.lpNorm<Eigen::Infinity>());
-  if (!candidate.allFinite() || !((a * residual).lpNorm<Eigen::Infinity>() <= rounding)) return false;
+  Vector& normal = work_.normal;
+  normal.noalias() = a * residual;
+  if (!candidate.allFinite() || !(normal.lpNorm<Eigen::Infinity>() <= rounding)) return false;
   p.swap(candidate);
   return true;
 }

@@ -60,8 +60,9 @@ class EqualitySolver {
     std::vector<int> slot, parent, start, fill, members;  // subset components
     Eigen::MatrixXd dense;
     Vector rhs;
-    Eigen::MatrixXd rank_factor, gram;  // solve_dense_matrix's minimum-norm solve: L_R and L_Rᵀ L_R
-    Vector pivots, permuted, reduced, candidate, residual;
+    Eigen::MatrixXd rank_factor, gram_matrix;  // solve_dense_matrix's minimum-norm solve: L_R, L_Rᵀ L_R
+    Eigen::LLT<Eigen::MatrixXd> gram;           // and its Cholesky factor
+    Vector pivots, permuted, reduced, candidate, residual, normal;
   };
   const SolverSettings& settings_;
   std::vector<FactorPtr> cache_;  // sparse factorizations by pattern, least recently used first

@@ -62,6 +62,7 @@ struct Island {
   BodySpace body_space;        ///< A's factored form for an impact that suits the interior point
   BodySpace correction_body_space;  ///< ... for a position correction (solved alongside the impact)
   bool correction_refused = false;  ///< the correction's solver refused its answer (zero returned)
+  std::vector<const resolution::ImpulseRow*> correction_rows;  ///< apply_correction's rows
   SparseMatrix restricted;     ///< and A over them
 
   /// A frictional island's impact (frictional_impact.cpp), in buffers kept the same way: the problem

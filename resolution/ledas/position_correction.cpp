@@ -86,7 +86,8 @@ void LedasResolver::apply_correction(ledas::Island& island, std::span<RigidBody>
     if (!problem.equality[j]) total_target += problem.rhs(static_cast<Eigen::Index>(j));
   ledas::Vector& q = island.correction_solution;
   // No correction moves a body absurdly far (conflicting targets: a body pinned deep in the ground).
-  std::vector<const resolution::ImpulseRow*> rows(m);
+  std::vector<const resolution::ImpulseRow*>& rows = island.correction_rows;
+  rows.resize(m);
   for (std::size_t j = 0; j < m; ++j) rows[j] = &rows_[island.rows[local(j)]];
   const resolution::CorrectionBound bound = resolution::bound_correction(
       rows, std::span<double>(q.data(), m), resolution::kCorrectionBoundFactor * total_target, bodies);
