@@ -209,9 +209,9 @@ void EqualitySolver::solve_dense_matrix(const Eigen::MatrixXd& a, const Vector& 
 // (Eigen pivots on the diagonal as it was, so they need not come first) and the others dropped,
 // A = B D_R Bᵀ with B = Pᵀ L_R, L's columns in R (independent: L is unit lower triangular), and
 //     A⁺ = B (BᵀB)⁻¹ D_R⁻¹ (BᵀB)⁻¹ Bᵀ,    BᵀB = L_Rᵀ L_R,
-// two r × r Cholesky solves where the eigen-decomposition costs ~9 n³ and a QR iteration: the latter
-// was 14% of a run of the pile of 100 primitives (a box resting on a face has four corner rows of rank
-// three). Dropping the small pivots is the eigen-decomposition's rank decision made on the pivots, so
+// two r × r Cholesky solves in place of an eigen-decomposition (a tridiagonal reduction and a QR
+// iteration): the dense solve, mostly that eigen-decomposition, was 14% of a run of the pile of 100
+// primitives in `perf` (a box resting on a face has four corner rows of rank three). Dropping the small pivots is the eigen-decomposition's rank decision made on the pivots, so
 // the answer is checked: A (A p − c) must vanish to rounding (the normal equations of least squares),
 // else false, p untouched, and the caller takes the eigen-decomposition.
 bool EqualitySolver::minimum_norm_from_ldlt(const Eigen::MatrixXd& a, const Eigen::LDLT<Eigen::MatrixXd>& ldlt,
